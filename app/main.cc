@@ -1,0 +1,116 @@
+// suspension: parse the command line, read the scene, pick the dimension,
+// run, and turn any error into one line on stderr and a non-zero exit.
+
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/parameter_handler.h>
+
+#include <suspension/core/parameters.h>
+#include <suspension/core/study.h>
+
+#include <fstream>
+#include <iostream>
+#include <regex>
+#include <string>
+
+namespace
+{
+  const char *usage =
+    "usage: suspension FILE.prm            run the scene described in FILE.prm\n"
+    "       suspension --print-parameters [2|3] [--json]\n"
+    "                                      every entry, its default and documentation\n"
+    "       suspension --help              this text\n";
+
+  /// deal.II's exception texts span several lines; a user wants one.
+  std::string one_line(std::string text)
+  {
+    text = std::regex_replace(text, std::regex("[\\s]+"), " ");
+    return std::regex_replace(text, std::regex("^ | $"), "");
+  }
+
+  int fail(const std::string &message)
+  {
+    std::cerr << "suspension: error: " << one_line(message) << std::endl;
+    return 1;
+  }
+} // namespace
+
+int main(int argc, char *argv[])
+{
+  using namespace Suspension;
+  dealii::Utilities::MPI::MPI_InitFinalize mpi(argc, argv, 1);
+  const std::vector<std::string> args(argv + 1, argv + argc);
+
+  if (args.empty())
+    {
+      std::cerr << usage;
+      return fail("no parameter file given");
+    }
+  if (args[0] == "--help" || args[0] == "-h")
+    {
+      std::cout << usage;
+      return 0;
+    }
+  if (args[0] == "--print-parameters")
+    {
+      unsigned int dim  = 2;
+      bool         json = false;
+      for (unsigned int i = 1; i < args.size(); ++i)
+        if (args[i] == "3")
+          dim = 3;
+        else if (args[i] == "--json")
+          json = true;
+      dealii::ParameterHandler prm;
+      Parameters::All::declare(prm, dim);
+      prm.print_parameters(std::cout, json ? dealii::ParameterHandler::JSON :
+                                             dealii::ParameterHandler::Text);
+      return 0;
+    }
+  if (args[0].rfind("--", 0) == 0)
+    {
+      std::cerr << usage;
+      return fail("unknown option '" + args[0] + "'");
+    }
+
+  const std::string filename = args[0];
+  Parameters::All   parameters;
+  try
+    {
+      if (!std::ifstream(filename))
+        return fail("cannot read parameter file '" + filename + "'");
+      const unsigned int dim = Parameters::read_dimension(filename);
+      parameters             = Parameters::read(filename, dim);
+    }
+  catch (const Parameters::InputError &e)
+    {
+      return fail("in '" + filename + "': " + e.what());
+    }
+  catch (const dealii::ExceptionBase &e)
+    {
+      std::ostringstream info;
+      e.print_info(info);
+      return fail("in '" + filename + "': " + info.str());
+    }
+  catch (const std::exception &e)
+    {
+      return fail("in '" + filename + "': " + e.what());
+    }
+
+  try
+    {
+      if (parameters.dimension == 2)
+        run_study<2>(parameters, MPI_COMM_WORLD);
+      else
+        run_study<3>(parameters, MPI_COMM_WORLD);
+    }
+  catch (const dealii::ExceptionBase &e)
+    {
+      std::ostringstream info;
+      e.print_info(info);
+      return fail(info.str());
+    }
+  catch (const std::exception &e)
+    {
+      return fail(e.what());
+    }
+  return 0;
+}

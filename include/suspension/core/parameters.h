@@ -1,0 +1,245 @@
+#pragma once
+
+#include <deal.II/base/parameter_handler.h>
+#include <deal.II/base/point.h>
+
+#include <array>
+#include <map>
+#include <string>
+#include <vector>
+
+/**
+ * Run-time parameters, one struct per subsection of the .prm file.
+ *
+ * Each struct declares its entries (with a Pattern and a sentence of
+ * documentation) and parses them back; defaults live only in the member
+ * initialisers. Checks that need more than a Pattern (lists of the right
+ * length, function expressions that parse, periodic faces in pairs) are done
+ * in parse() and reported as InputError, so that a bad file is rejected
+ * before anything is written.
+ *
+ * Dimensionless convention used by all shipped scenes: half-height h = 1,
+ * bulk velocity V_b = 1, density rho = 1, hence viscosity mu = 1/Re_b.
+ */
+namespace Suspension::Parameters
+{
+  using dealii::ParameterHandler;
+
+  /// A parse error in the user's input: which entry, and what is wrong.
+  struct InputError : std::runtime_error
+  {
+    InputError(const std::string &entry, const std::string &message)
+      : std::runtime_error("entry '" + entry + "': " + message)
+    {}
+  };
+
+  /// A function expression with its constants; the variables are
+  /// x, y[, z], t. Components are separated by ';'.
+  struct FunctionExpression
+  {
+    std::string expression;
+    std::string constants;
+    std::map<std::string, double> constant_map() const;
+    bool        is_zero() const;
+  };
+
+  enum class GeometryType
+  {
+    channel,
+    box
+  };
+
+  struct Geometry
+  {
+    GeometryType type = GeometryType::channel;
+    // channel: x in [0, Lx], (3D) y in [0, Ly], wall-normal in [-h, h]
+    double streamwise_length = 6.;
+    double spanwise_length   = 3.;
+    double half_height       = 1.;
+    // box
+    std::vector<double> box_lower{0., 0., 0.};
+    std::vector<double> box_upper{1., 1., 1.};
+    // base cells per direction; empty: cells of aspect ratio one
+    std::vector<unsigned int> subdivisions;
+
+    static void declare(ParameterHandler &prm, unsigned int dim);
+    void        parse(ParameterHandler &prm, unsigned int dim);
+  };
+
+  struct Mesh
+  {
+    unsigned int global_refinements = 2;
+    // cells whose centre makes this expression positive are refined
+    // `region_refinements` more times (hanging nodes by hand)
+    std::string  refinement_region;
+    unsigned int region_refinements = 0;
+
+    static void declare(ParameterHandler &prm);
+    void        parse(ParameterHandler &prm, unsigned int dim);
+  };
+
+  enum class BoundaryType
+  {
+    no_slip,
+    velocity,
+    periodic
+  };
+
+  /// Faces are numbered as GridGenerator colours them:
+  /// 0 = x-, 1 = x+, 2 = y-, 3 = y+, 4 = z-, 5 = z+.
+  struct BoundaryConditions
+  {
+    std::array<BoundaryType, 6>       type;
+    std::array<FunctionExpression, 6> velocity;
+
+    BoundaryConditions();
+    static std::string face_name(unsigned int face);
+    static void        declare(ParameterHandler &prm, unsigned int dim);
+    void               parse(ParameterHandler &prm, unsigned int dim);
+  };
+
+  enum class FlowDrivingType
+  {
+    none,
+    constant_flow_rate,
+    constant_pressure_gradient
+  };
+
+  struct FlowDriving
+  {
+    FlowDrivingType    type          = FlowDrivingType::none;
+    double             bulk_velocity = 1.;
+    double             pressure_gradient = 0.; // driving force -dp/dx
+    FunctionExpression body_force{"", ""};
+
+    static void declare(ParameterHandler &prm, unsigned int dim);
+    void        parse(ParameterHandler &prm, unsigned int dim);
+  };
+
+  struct Material
+  {
+    double density   = 1.;
+    double viscosity = 1.;
+
+    static void declare(ParameterHandler &prm);
+    void        parse(ParameterHandler &prm);
+  };
+
+  struct InitialConditions
+  {
+    FunctionExpression velocity{"", ""};
+
+    static void declare(ParameterHandler &prm, unsigned int dim);
+    void        parse(ParameterHandler &prm, unsigned int dim);
+  };
+
+  enum class ProjectionForm
+  {
+    rotational,
+    standard
+  };
+
+  enum class ConvectionForm
+  {
+    skew_symmetric,
+    none
+  };
+
+  struct FluidSolver
+  {
+    unsigned int   velocity_degree = 2;
+    unsigned int   pressure_degree = 1;
+    ProjectionForm projection      = ProjectionForm::rotational;
+    ConvectionForm convection      = ConvectionForm::skew_symmetric;
+    double         solver_tolerance = 1e-10;
+
+    static void declare(ParameterHandler &prm);
+    void        parse(ParameterHandler &prm);
+  };
+
+  struct TimeStepping
+  {
+    double       end_time           = 1.;
+    double       time_step          = 1e-2;
+    bool         adaptive           = false;
+    double       cfl                = 0.5;
+    double       maximum_time_step  = 1.;
+    double       steady_tolerance   = 0.;
+    unsigned int maximum_steps      = 0;
+
+    static void declare(ParameterHandler &prm);
+    void        parse(ParameterHandler &prm);
+  };
+
+  struct Output
+  {
+    std::string                     directory = "output";
+    bool                            write_vtu = true;
+    unsigned int                    interval_steps = 0;
+    double                          interval_time  = 0.;
+    std::vector<std::vector<double>> probe_points;
+    unsigned int                    progress_interval = 10;
+    bool                            timer_summary     = true;
+
+    static void declare(ParameterHandler &prm);
+    void        parse(ParameterHandler &prm, unsigned int dim);
+  };
+
+  enum class ExactSolutionType
+  {
+    none,
+    function,
+    channel_startup
+  };
+
+  enum class ReferenceData
+  {
+    none,
+    ghia_re100
+  };
+
+  /// What the run is compared with, and how a study repeats it.
+  struct Verification
+  {
+    ExactSolutionType   exact_solution = ExactSolutionType::none;
+    FunctionExpression  exact_velocity{"", ""};
+    std::string         exact_pressure;
+    std::vector<double> report_times;
+    ReferenceData       reference_data = ReferenceData::none;
+    unsigned int        refinement_cycles = 1;
+    unsigned int        time_step_cycles  = 1;
+
+    static void declare(ParameterHandler &prm, unsigned int dim);
+    void        parse(ParameterHandler &prm, unsigned int dim);
+  };
+
+  /// All subsections together: what a Simulation is built from.
+  struct All
+  {
+    unsigned int       dimension = 2;
+    std::string        input_file;
+    Geometry           geometry;
+    Mesh               mesh;
+    BoundaryConditions boundary_conditions;
+    FlowDriving        flow_driving;
+    Material           material;
+    InitialConditions  initial_conditions;
+    FluidSolver        fluid_solver;
+    TimeStepping       time_stepping;
+    Output             output;
+    Verification       verification;
+
+    static void declare(ParameterHandler &prm, unsigned int dim);
+    void        parse(ParameterHandler &prm, unsigned int dim);
+  };
+
+  /// Reads only `Dimension` from a file (other entries are skipped).
+  unsigned int read_dimension(const std::string &filename);
+
+  /// Declares, reads and checks the whole file for the given dimension.
+  /// Throws InputError (or a deal.II exception from ParameterHandler).
+  All read(const std::string &filename, unsigned int dim);
+
+  /// Variable names for function expressions: "x,y,t" or "x,y,z,t".
+  std::string variable_names(unsigned int dim);
+} // namespace Suspension::Parameters

@@ -1,0 +1,71 @@
+#pragma once
+
+#include <deal.II/base/conditional_ostream.h>
+#include <deal.II/base/table_handler.h>
+#include <deal.II/base/timer.h>
+#include <deal.II/distributed/tria.h>
+
+#include <suspension/core/parameters.h>
+#include <suspension/core/scene.h>
+#include <suspension/fluid/fluid_operators.h>
+#include <suspension/fluid/fluid_space.h>
+#include <suspension/fluid/projection_scheme.h>
+#include <suspension/postprocess/field_output.h>
+#include <suspension/postprocess/flow_verification.h>
+
+#include <memory>
+#include <vector>
+
+namespace Suspension
+{
+  /// What a finished run reports to a study: its errors and resolution.
+  struct RunSummary
+  {
+    Postprocess::FlowErrors final_errors;
+    double                  smallest_cell = 0.;
+    double                  time_step     = 0.;
+    unsigned int            n_steps       = 0;
+    types::global_dof_index n_dofs        = 0;
+  };
+
+  /**
+   * One run of a scene: builds the mesh and the parts, then advances in
+   * time. Owns nothing numerical itself; run() reads as the time step:
+   * choose dt -> fluid step -> diagnostics -> statistics, output, progress.
+   */
+  template <int dim>
+  class Simulation
+  {
+  public:
+    Simulation(const Parameters::All &parameters, MPI_Comm communicator);
+    RunSummary run();
+
+  private:
+    void   setup();
+    double choose_time_step(double dt, double time, const Fluid::FlowDiagnostics &d) const;
+    bool   output_due(double time, double dt) const;
+    void   write_output();
+    void   write_probes();
+    void   add_statistics_row(const Fluid::StepReport &r, const Fluid::FlowDiagnostics &d,
+                              double dt, double wall_time);
+    void   report_errors(double time);
+    void   print_progress(double dt, const Fluid::FlowDiagnostics &d, double elapsed) const;
+    void   write_tables() const;
+
+    const Parameters::All                    &parameters;
+    MPI_Comm                                  communicator;
+    ConditionalOStream                        pcout;
+    mutable TimerOutput                       timer;
+    parallel::distributed::Triangulation<dim> triangulation;
+    Scene<dim>                                scene;
+    Fluid::FluidSpace<dim>                    space;
+    Fluid::FluidOperators<dim>                operators;
+    Fluid::ProjectionScheme<dim>              fluid;
+    std::unique_ptr<Fluid::MomentumSource<dim>> body_force;
+    Postprocess::FieldOutput<dim>             field_output;
+    Postprocess::FlowVerification<dim>        verification;
+    TableHandler                              statistics, probes;
+    Postprocess::FlowErrors                   last_errors;
+    double                                    last_output_time = 0.;
+  };
+} // namespace Suspension

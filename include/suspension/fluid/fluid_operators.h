@@ -1,0 +1,58 @@
+#pragma once
+
+#include <deal.II/lac/generic_linear_algebra.h>
+#include <deal.II/lac/petsc_precondition.h>
+#include <deal.II/lac/petsc_solver.h>
+
+#include <suspension/fluid/fluid_space.h>
+
+#include <memory>
+
+namespace Suspension::Fluid
+{
+  using VectorType = LinearAlgebraPETSc::MPI::Vector;
+  using MatrixType = LinearAlgebraPETSc::MPI::SparseMatrix;
+
+  /**
+   * The matrices of the projection scheme that do not depend on the
+   * solution, assembled once per mesh (and, for the momentum matrix, once
+   * per time-step size), with their preconditioners:
+   *
+   *   velocity  M (mass), K (vector Laplacian), A = (alpha/dt) M + nu K,
+   *   pressure  L (Laplacian, increment constraints), Mp (mass),
+   *   D         (div v_j, q_i): pressure rows (condensed), velocity columns
+   *             (not condensed, so D u is exact for any u with its boundary
+   *             values),
+   *   flux      m_x . u = integral of u_x, and b_x = (e_x, v) condensed,
+   *             the load of a unit streamwise force.
+   *
+   * Convection is explicit, so A is symmetric positive definite and the
+   * whole step needs CG with BoomerAMG only.
+   */
+  template <int dim>
+  class FluidOperators
+  {
+  public:
+    /// Assembles everything for the current mesh.
+    void reinit(const FluidSpace<dim> &space);
+
+    /// A = (alpha/dt) M + nu K and its preconditioner. Cheap to call with
+    /// unchanged arguments (nothing is done).
+    void set_momentum_coefficients(double alpha_over_dt, double nu);
+
+    /// Solves with CG + the stored preconditioner; returns iterations.
+    unsigned int solve_momentum(VectorType &x, const VectorType &b, double tolerance) const;
+    unsigned int solve_pressure_laplace(VectorType &x, const VectorType &b, double tolerance) const;
+    unsigned int solve_pressure_mass(VectorType &x, const VectorType &b, double tolerance) const;
+
+    MatrixType M, K, A, L, Mp, D;
+    VectorType flux_weights; // m_x
+    VectorType unit_force;   // b_x
+    double     momentum_alpha_over_dt = -1., momentum_nu = -1.;
+
+  private:
+    MPI_Comm                                             communicator;
+    std::unique_ptr<PETScWrappers::PreconditionBoomerAMG> amg_momentum, amg_pressure;
+    std::unique_ptr<PETScWrappers::PreconditionJacobi>    jacobi_mass;
+  };
+} // namespace Suspension::Fluid

@@ -1,0 +1,104 @@
+#pragma once
+
+#include <suspension/core/parameters.h>
+#include <suspension/core/scene.h>
+#include <suspension/fluid/fluid_operators.h>
+#include <suspension/fluid/fluid_space.h>
+#include <suspension/fluid/momentum_source.h>
+
+#include <vector>
+
+namespace Suspension::Fluid
+{
+  /// What one step did: linear iterations and the mean pressure gradient.
+  struct StepReport
+  {
+    unsigned int momentum_iterations   = 0;
+    unsigned int projection_iterations = 0;
+    unsigned int mass_iterations       = 0;
+    double       driving_force         = 0.; // -dp/dx (force per volume)
+    bool         matrices_rebuilt      = false;
+  };
+
+  /// Integral quantities of the velocity at the end of a step.
+  struct FlowDiagnostics
+  {
+    double kinetic_energy      = 0.; // (rho/2) integral |u|^2
+    double bulk_velocity       = 0.; // integral u_x / |Omega|
+    double max_speed_over_h    = 0.; // max over cells of |u| k / h
+    double divergence_l2       = 0.; // || Pi div u ||, Pi: L2 projection
+    double max_speed           = 0.;
+  };
+
+  /**
+   * Incremental pressure-correction projection in rotational form with
+   * BDF2 (Guermond, Minev & Shen 2006, Comput. Methods Appl. Mech. Engrg.
+   * 195), kinematic pressure P = p / rho, nu = mu / rho:
+   *
+   *  1. momentum  (alpha u^{n+1} - beta_1 u^n + beta_2 u^{n-1}) / dt
+   *               - nu lap u^{n+1} = - (u*.grad) u* - div(u*) u* / 2
+   *               - grad P# + (f + div tau) / rho + F e_x / rho,
+   *     u* and P# = P^n + (4 psi^n - psi^{n-1}) / 3 extrapolated,
+   *  2. flow rate F chosen so that the bulk velocity is exact: by linearity
+   *     u^{n+1} = u_0 + F u_1 with u_1 the (stored) response to a unit force,
+   *  3. projection  -lap psi^{n+1} = -(alpha / dt) div u^{n+1}, Neumann,
+   *  4. pressure    P^{n+1} = P^n + psi^{n+1} - nu Pi div u^{n+1}.
+   *
+   * Convection is explicit, so the momentum matrix is constant between
+   * mesh or time-step changes. The first step is BDF1; variable steps use
+   * the variable-step BDF2 coefficients.
+   */
+  template <int dim>
+  class ProjectionScheme
+  {
+  public:
+    ProjectionScheme(const Parameters::All &parameters,
+                     const Scene<dim>      &scene,
+                     const FluidSpace<dim> &space,
+                     FluidOperators<dim>   &operators);
+
+    /// Allocates the time levels and sets u^0 from the scene, P^0 = 0.
+    void initialize();
+
+    /// Advances from the current time by dt.
+    StepReport advance(double dt, const std::vector<const MomentumSource<dim> *> &sources);
+
+    FlowDiagnostics compute_diagnostics() const;
+
+    /// max |u^{n+1} - u^n| / (dt max |u^{n+1}|)
+    double relative_change_rate() const;
+
+    double time() const { return current_time; }
+    unsigned int step_number() const { return n_steps; }
+
+    const VectorType &velocity() const { return velocity_ghosted; }
+    /// Kinematic pressure P = p / rho (ghosted).
+    const VectorType &kinematic_pressure() const { return pressure_ghosted; }
+
+  private:
+    void       assemble_momentum_rhs(double dt, double t_new,
+                                     const std::vector<const MomentumSource<dim> *> &sources);
+    void       update_unit_response();
+    double     flux(const VectorType &u) const;
+
+    const Parameters::All &parameters;
+    const Scene<dim>      &scene;
+    const FluidSpace<dim> &space;
+    FluidOperators<dim>   &operators;
+    const double           nu;
+
+    AffineConstraints<double> step_constraints; // with boundary data at t^{n+1}
+
+    // time levels (owned) and ghosted views for cell loops
+    VectorType u, u_old, u_older, unit_response;
+    VectorType p, psi, psi_old, div_u, div_u_load;
+    VectorType rhs_u, rhs_p;
+    VectorType velocity_ghosted, pressure_ghosted;
+    VectorType u_star_ghosted, u_history_ghosted, p_sharp_ghosted;
+
+    double       current_time = 0., last_dt = 0.;
+    unsigned int n_steps      = 0;
+    double       alpha = 1., beta_1 = 1., beta_2 = 0.;
+    double       last_change_rate = 0.;
+  };
+} // namespace Suspension::Fluid

@@ -1,0 +1,36 @@
+#pragma once
+
+#include <suspension/fluid/fluid_space.h>
+#include <suspension/fluid/fluid_operators.h>
+
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace Suspension::Postprocess
+{
+  using namespace dealii;
+
+  /**
+   * Writes the fields of one output step as .pvtu + .vtu pieces
+   * (velocity, pressure, vorticity, MPI rank, refinement level) and keeps
+   * a .pvd index of all steps for ParaView, rewritten each time.
+   */
+  template <int dim>
+  class FieldOutput
+  {
+  public:
+    explicit FieldOutput(const std::string &directory);
+
+    void write(const Fluid::FluidSpace<dim> &space,
+               const Fluid::VectorType      &velocity,
+               const Fluid::VectorType      &kinematic_pressure,
+               double                        density,
+               double                        time);
+
+  private:
+    std::string                                  directory;
+    unsigned int                                 counter = 0;
+    std::vector<std::pair<double, std::string>> records;
+  };
+} // namespace Suspension::Postprocess

@@ -1,0 +1,725 @@
+#include <deal.II/base/function_parser.h>
+#include <deal.II/base/utilities.h>
+
+#include <suspension/core/parameters.h>
+
+#include <fstream>
+
+namespace Suspension::Parameters
+{
+  using namespace dealii;
+
+  namespace
+  {
+    std::vector<std::string> split(const std::string &s, const char sep)
+    {
+      std::vector<std::string> out;
+      if (Utilities::trim(s).empty())
+        return out;
+      for (const auto &piece : Utilities::split_string_list(s, sep))
+        out.push_back(Utilities::trim(piece));
+      return out;
+    }
+
+    std::vector<double> to_doubles(const std::string &entry,
+                                   const std::string &value)
+    {
+      std::vector<double> out;
+      for (const auto &piece : split(value, ','))
+        try
+          {
+            out.push_back(Utilities::string_to_double(piece));
+          }
+        catch (...)
+          {
+            throw InputError(entry, "'" + piece + "' is not a number");
+          }
+      return out;
+    }
+
+    /// Throws InputError unless `expression` parses as a function of
+    /// x, y[, z], t with `n_components` components.
+    void check_expression(const std::string        &entry,
+                          const FunctionExpression &f,
+                          const unsigned int        n_components,
+                          const unsigned int        dim)
+    {
+      const auto parts = split(f.expression, ';');
+      if (parts.size() != n_components)
+        throw InputError(entry,
+                         "expected " + std::to_string(n_components) +
+                           " component(s) separated by ';', found " +
+                           std::to_string(parts.size()));
+      try
+        {
+          if (dim == 2)
+            FunctionParser<2>(n_components)
+              .initialize(variable_names(2),
+                          f.expression,
+                          f.constant_map(),
+                          true);
+          else
+            FunctionParser<3>(n_components)
+              .initialize(variable_names(3),
+                          f.expression,
+                          f.constant_map(),
+                          true);
+        }
+      catch (...)
+        {
+          throw InputError(entry,
+                           "cannot parse '" + f.expression +
+                             "' as a function of " + variable_names(dim));
+        }
+    }
+
+    std::string zero_vector(const unsigned int dim)
+    {
+      return dim == 2 ? "0; 0" : "0; 0; 0";
+    }
+  } // namespace
+
+  std::string variable_names(const unsigned int dim)
+  {
+    return dim == 2 ? "x,y,t" : "x,y,z,t";
+  }
+
+  std::map<std::string, double> FunctionExpression::constant_map() const
+  {
+    std::map<std::string, double> out;
+    for (const auto &pair : split(constants, ','))
+      {
+        const auto kv = split(pair, '=');
+        if (kv.size() != 2)
+          throw InputError("Function constants",
+                           "'" + pair + "' is not of the form name=value");
+        try
+          {
+            out[kv[0]] = Utilities::string_to_double(kv[1]);
+          }
+        catch (...)
+          {
+            throw InputError("Function constants",
+                             "'" + kv[1] + "' is not a number");
+          }
+      }
+    return out;
+  }
+
+  bool FunctionExpression::is_zero() const
+  {
+    for (const auto &c : split(expression, ';'))
+      if (c != "0" && c != "0.0" && c != "0.")
+        return false;
+    return true;
+  }
+
+  // ---------------------------------------------------------------- Geometry
+  void Geometry::declare(ParameterHandler &prm, const unsigned int dim)
+  {
+    const Geometry d;
+    prm.enter_subsection("Geometry");
+    prm.declare_entry("Type",
+                      "channel",
+                      Patterns::Selection("channel|box"),
+                      "channel: walls at (wall-normal coordinate) = +-h, "
+                      "periodic in x (and y in 3D); the wall-normal "
+                      "coordinate is the last one (y in 2D, z in 3D). "
+                      "box: a rectangle/box whose faces each take a "
+                      "condition from 'Boundary conditions'.");
+    prm.declare_entry("Streamwise length",
+                      std::to_string(d.streamwise_length),
+                      Patterns::Double(0., Patterns::Double::max_double_value),
+                      "Channel length in x (the flow direction).");
+    prm.declare_entry("Spanwise length",
+                      std::to_string(d.spanwise_length),
+                      Patterns::Double(0., Patterns::Double::max_double_value),
+                      "Channel width in y (3D only).");
+    prm.declare_entry("Half height",
+                      std::to_string(d.half_height),
+                      Patterns::Double(0., Patterns::Double::max_double_value),
+                      "Channel half-height h: walls at -h and +h.");
+    prm.declare_entry("Box lower corner",
+                      dim == 2 ? "0, 0" : "0, 0, 0",
+                      Patterns::List(Patterns::Double(), dim, dim),
+                      "Lower corner of the box.");
+    prm.declare_entry("Box upper corner",
+                      dim == 2 ? "1, 1" : "1, 1, 1",
+                      Patterns::List(Patterns::Double(), dim, dim),
+                      "Upper corner of the box.");
+    prm.declare_entry("Subdivisions",
+                      "",
+                      Patterns::List(Patterns::Integer(1), 0, dim),
+                      "Base (coarse) cells per direction, before refinement. "
+                      "Empty: as many as give cells of aspect ratio one.");
+    prm.leave_subsection();
+  }
+
+  void Geometry::parse(ParameterHandler &prm, const unsigned int dim)
+  {
+    prm.enter_subsection("Geometry");
+    type = prm.get("Type") == "channel" ? GeometryType::channel :
+                                          GeometryType::box;
+    streamwise_length = prm.get_double("Streamwise length");
+    spanwise_length   = prm.get_double("Spanwise length");
+    half_height       = prm.get_double("Half height");
+    box_lower = to_doubles("Geometry/Box lower corner", prm.get("Box lower corner"));
+    box_upper = to_doubles("Geometry/Box upper corner", prm.get("Box upper corner"));
+    subdivisions.clear();
+    for (const auto &s : split(prm.get("Subdivisions"), ','))
+      subdivisions.push_back(Utilities::string_to_int(s));
+    prm.leave_subsection();
+
+    if (type == GeometryType::channel)
+      {
+        box_lower = {0., -half_height};
+        box_upper = {streamwise_length, half_height};
+        if (dim == 3)
+          {
+            box_lower = {0., 0., -half_height};
+            box_upper = {streamwise_length, spanwise_length, half_height};
+          }
+      }
+    for (unsigned int d = 0; d < dim; ++d)
+      if (!(box_upper[d] > box_lower[d]))
+        throw InputError("Geometry/Box upper corner",
+                         "must exceed the lower corner in every direction");
+    if (!subdivisions.empty() && subdivisions.size() != dim)
+      throw InputError("Geometry/Subdivisions",
+                       "give one count per direction (" + std::to_string(dim) +
+                         ") or leave empty");
+    if (subdivisions.empty())
+      {
+        double shortest = box_upper[0] - box_lower[0];
+        for (unsigned int d = 1; d < dim; ++d)
+          shortest = std::min(shortest, box_upper[d] - box_lower[d]);
+        for (unsigned int d = 0; d < dim; ++d)
+          subdivisions.push_back(static_cast<unsigned int>(
+            std::max(1.0, std::round((box_upper[d] - box_lower[d]) / shortest))));
+      }
+  }
+
+  // -------------------------------------------------------------------- Mesh
+  void Mesh::declare(ParameterHandler &prm)
+  {
+    const Mesh d;
+    prm.enter_subsection("Mesh");
+    prm.declare_entry("Global refinements",
+                      std::to_string(d.global_refinements),
+                      Patterns::Integer(0, 12),
+                      "Number of times every base cell is refined.");
+    prm.declare_entry("Refinement region",
+                      "",
+                      Patterns::Anything(),
+                      "Function expression of x, y[, z]: cells whose centre "
+                      "makes it positive are refined 'Region refinements' "
+                      "more times (a hand-made locally refined mesh with "
+                      "hanging nodes). Empty: none.");
+    prm.declare_entry("Region refinements",
+                      std::to_string(d.region_refinements),
+                      Patterns::Integer(0, 6),
+                      "Extra refinement levels inside 'Refinement region'.");
+    prm.leave_subsection();
+  }
+
+  void Mesh::parse(ParameterHandler &prm, const unsigned int dim)
+  {
+    prm.enter_subsection("Mesh");
+    global_refinements = prm.get_integer("Global refinements");
+    refinement_region  = Utilities::trim(prm.get("Refinement region"));
+    region_refinements = prm.get_integer("Region refinements");
+    prm.leave_subsection();
+    if (!refinement_region.empty())
+      check_expression("Mesh/Refinement region",
+                       {refinement_region, ""},
+                       1,
+                       dim);
+  }
+
+  // ------------------------------------------------------ BoundaryConditions
+  BoundaryConditions::BoundaryConditions()
+  {
+    type.fill(BoundaryType::no_slip);
+  }
+
+  std::string BoundaryConditions::face_name(const unsigned int face)
+  {
+    static const char *names[] = {"x-", "x+", "y-", "y+", "z-", "z+"};
+    return names[face];
+  }
+
+  void BoundaryConditions::declare(ParameterHandler &prm,
+                                   const unsigned int dim)
+  {
+    prm.enter_subsection("Boundary conditions");
+    prm.declare_entry("Function constants",
+                      "",
+                      Patterns::Anything(),
+                      "Constants for the velocity expressions below, as "
+                      "name=value pairs separated by commas.");
+    for (unsigned int f = 0; f < 2 * dim; ++f)
+      {
+        prm.enter_subsection("Face " + face_name(f));
+        prm.declare_entry("Type",
+                          "no-slip",
+                          Patterns::Selection("no-slip|velocity|periodic"),
+                          "no-slip: u = 0; velocity: u given by 'Velocity'; "
+                          "periodic: identified with the opposite face (both "
+                          "must say so). Ignored for the channel's periodic "
+                          "directions, which are always periodic.");
+        prm.declare_entry("Velocity",
+                          zero_vector(dim),
+                          Patterns::Anything(),
+                          "Velocity on this face when Type = velocity: one "
+                          "expression of x, y[, z], t per component, "
+                          "separated by ';'.");
+        prm.leave_subsection();
+      }
+    prm.leave_subsection();
+  }
+
+  void BoundaryConditions::parse(ParameterHandler &prm, const unsigned int dim)
+  {
+    prm.enter_subsection("Boundary conditions");
+    const std::string constants = prm.get("Function constants");
+    for (unsigned int f = 0; f < 2 * dim; ++f)
+      {
+        prm.enter_subsection("Face " + face_name(f));
+        const std::string t = prm.get("Type");
+        type[f] = t == "no-slip"  ? BoundaryType::no_slip :
+                  t == "velocity" ? BoundaryType::velocity :
+                                    BoundaryType::periodic;
+        velocity[f] = {prm.get("Velocity"), constants};
+        prm.leave_subsection();
+        if (type[f] == BoundaryType::velocity)
+          check_expression("Boundary conditions/Face " + face_name(f) +
+                             "/Velocity",
+                           velocity[f],
+                           dim,
+                           dim);
+      }
+    prm.leave_subsection();
+    for (unsigned int d = 0; d < dim; ++d)
+      if ((type[2 * d] == BoundaryType::periodic) !=
+          (type[2 * d + 1] == BoundaryType::periodic))
+        throw InputError("Boundary conditions/Face " + face_name(2 * d) +
+                           "/Type",
+                         "periodic faces come in pairs: set both " +
+                           face_name(2 * d) + " and " + face_name(2 * d + 1) +
+                           " to periodic");
+  }
+
+  // ------------------------------------------------------------- FlowDriving
+  void FlowDriving::declare(ParameterHandler &prm, const unsigned int dim)
+  {
+    const FlowDriving d;
+    prm.enter_subsection("Flow driving");
+    prm.declare_entry("Type",
+                      "none",
+                      Patterns::Selection(
+                        "none|constant flow rate|constant pressure gradient"),
+                      "How the flow in x is driven: constant flow rate holds "
+                      "the bulk velocity exactly each step by a dynamic mean "
+                      "pressure gradient; constant pressure gradient applies "
+                      "a fixed one.");
+    prm.declare_entry("Bulk velocity",
+                      std::to_string(d.bulk_velocity),
+                      Patterns::Double(),
+                      "Target bulk (volume-averaged streamwise) velocity V_b "
+                      "for Type = constant flow rate.");
+    prm.declare_entry("Pressure gradient",
+                      std::to_string(d.pressure_gradient),
+                      Patterns::Double(),
+                      "Driving force -dp/dx (positive drives flow in +x) for "
+                      "Type = constant pressure gradient.");
+    prm.declare_entry("Function constants",
+                      "",
+                      Patterns::Anything(),
+                      "Constants for 'Body force', name=value pairs.");
+    prm.declare_entry("Body force",
+                      zero_vector(dim),
+                      Patterns::Anything(),
+                      "Body force per unit volume, one expression of x, y[, "
+                      "z], t per component separated by ';'.");
+    prm.leave_subsection();
+  }
+
+  void FlowDriving::parse(ParameterHandler &prm, const unsigned int dim)
+  {
+    prm.enter_subsection("Flow driving");
+    const std::string t = prm.get("Type");
+    type = t == "none"                  ? FlowDrivingType::none :
+           t == "constant flow rate"    ? FlowDrivingType::constant_flow_rate :
+                                          FlowDrivingType::constant_pressure_gradient;
+    bulk_velocity     = prm.get_double("Bulk velocity");
+    pressure_gradient = prm.get_double("Pressure gradient");
+    body_force        = {prm.get("Body force"), prm.get("Function constants")};
+    prm.leave_subsection();
+    check_expression("Flow driving/Body force", body_force, dim, dim);
+  }
+
+  // ---------------------------------------------------------------- Material
+  void Material::declare(ParameterHandler &prm)
+  {
+    const Material d;
+    prm.enter_subsection("Material");
+    prm.declare_entry("Density",
+                      std::to_string(d.density),
+                      Patterns::Double(1e-300, Patterns::Double::max_double_value),
+                      "Density rho, equal in both phases (1 in the "
+                      "dimensionless convention).");
+    prm.declare_entry("Viscosity",
+                      std::to_string(d.viscosity),
+                      Patterns::Double(1e-300, Patterns::Double::max_double_value),
+                      "Dynamic viscosity mu, equal in both phases (1/Re_b in "
+                      "the dimensionless convention h = V_b = rho = 1).");
+    prm.leave_subsection();
+  }
+
+  void Material::parse(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Material");
+    density   = prm.get_double("Density");
+    viscosity = prm.get_double("Viscosity");
+    prm.leave_subsection();
+  }
+
+  // ------------------------------------------------------- InitialConditions
+  void InitialConditions::declare(ParameterHandler &prm, const unsigned int dim)
+  {
+    prm.enter_subsection("Initial conditions");
+    prm.declare_entry("Function constants",
+                      "",
+                      Patterns::Anything(),
+                      "Constants for 'Velocity', name=value pairs.");
+    prm.declare_entry("Velocity",
+                      zero_vector(dim),
+                      Patterns::Anything(),
+                      "Initial velocity, one expression of x, y[, z] (t = 0) "
+                      "per component separated by ';'.");
+    prm.leave_subsection();
+  }
+
+  void InitialConditions::parse(ParameterHandler &prm, const unsigned int dim)
+  {
+    prm.enter_subsection("Initial conditions");
+    velocity = {prm.get("Velocity"), prm.get("Function constants")};
+    prm.leave_subsection();
+    check_expression("Initial conditions/Velocity", velocity, dim, dim);
+  }
+
+  // ------------------------------------------------------------- FluidSolver
+  void FluidSolver::declare(ParameterHandler &prm)
+  {
+    const FluidSolver d;
+    prm.enter_subsection("Fluid solver");
+    prm.declare_entry("Velocity degree",
+                      std::to_string(d.velocity_degree),
+                      Patterns::Integer(2, 4),
+                      "Polynomial degree of the continuous (Q_k) velocity.");
+    prm.declare_entry("Pressure degree",
+                      std::to_string(d.pressure_degree),
+                      Patterns::Integer(1, 3),
+                      "Polynomial degree of the continuous pressure; must be "
+                      "below the velocity degree (inf-sup stability).");
+    prm.declare_entry("Projection form",
+                      "rotational",
+                      Patterns::Selection("rotational|standard"),
+                      "Pressure update of the incremental projection: "
+                      "rotational (p += psi - mu div u, Guermond-Minev-Shen "
+                      "2006) or standard (p += psi).");
+    prm.declare_entry("Convection",
+                      "skew-symmetric",
+                      Patterns::Selection("skew-symmetric|none"),
+                      "Convective term, extrapolated explicitly to second "
+                      "order: skew-symmetric (u.grad u + div(u) u / 2) or "
+                      "none (unsteady Stokes).");
+    prm.declare_entry("Linear solver tolerance",
+                      "1e-10",
+                      Patterns::Double(1e-16, 1e-2),
+                      "Relative residual reduction asked of every linear "
+                      "solve (CG with BoomerAMG).");
+    prm.leave_subsection();
+  }
+
+  void FluidSolver::parse(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Fluid solver");
+    velocity_degree  = prm.get_integer("Velocity degree");
+    pressure_degree  = prm.get_integer("Pressure degree");
+    projection       = prm.get("Projection form") == "rotational" ?
+                         ProjectionForm::rotational :
+                         ProjectionForm::standard;
+    convection       = prm.get("Convection") == "none" ?
+                         ConvectionForm::none :
+                         ConvectionForm::skew_symmetric;
+    solver_tolerance = prm.get_double("Linear solver tolerance");
+    prm.leave_subsection();
+    if (pressure_degree >= velocity_degree)
+      throw InputError("Fluid solver/Pressure degree",
+                       "must be lower than the velocity degree (" +
+                         std::to_string(velocity_degree) + ")");
+  }
+
+  // ------------------------------------------------------------ TimeStepping
+  void TimeStepping::declare(ParameterHandler &prm)
+  {
+    const TimeStepping d;
+    prm.enter_subsection("Time stepping");
+    prm.declare_entry("End time",
+                      std::to_string(d.end_time),
+                      Patterns::Double(0., Patterns::Double::max_double_value),
+                      "Time at which the run ends.");
+    prm.declare_entry("Time step",
+                      "0.01",
+                      Patterns::Double(1e-300, Patterns::Double::max_double_value),
+                      "Time step; with 'Adaptive time step' the first one.");
+    prm.declare_entry("Adaptive time step",
+                      "false",
+                      Patterns::Bool(),
+                      "Choose the time step from 'CFL number'. It is changed "
+                      "only when the CFL number leaves [0.5, 1] times the "
+                      "target, because a new step size means new matrices.");
+    prm.declare_entry("CFL number",
+                      std::to_string(d.cfl),
+                      Patterns::Double(1e-6, 100.),
+                      "Target CFL number max(|u| dt / h) / degree for the "
+                      "adaptive time step.");
+    prm.declare_entry("Maximum time step",
+                      std::to_string(d.maximum_time_step),
+                      Patterns::Double(1e-300, Patterns::Double::max_double_value),
+                      "Upper bound of the adaptive time step.");
+    prm.declare_entry("Steady state tolerance",
+                      "0",
+                      Patterns::Double(0., 1.),
+                      "Stop once max|u^{n+1} - u^n| / (dt max|u|) falls "
+                      "below this value (0: run to the end time).");
+    prm.declare_entry("Maximum number of steps",
+                      "0",
+                      Patterns::Integer(0),
+                      "Stop after this many steps (0: no limit).");
+    prm.leave_subsection();
+  }
+
+  void TimeStepping::parse(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Time stepping");
+    end_time          = prm.get_double("End time");
+    time_step         = prm.get_double("Time step");
+    adaptive          = prm.get_bool("Adaptive time step");
+    cfl               = prm.get_double("CFL number");
+    maximum_time_step = prm.get_double("Maximum time step");
+    steady_tolerance  = prm.get_double("Steady state tolerance");
+    maximum_steps     = prm.get_integer("Maximum number of steps");
+    prm.leave_subsection();
+  }
+
+  // ------------------------------------------------------------------ Output
+  void Output::declare(ParameterHandler &prm)
+  {
+    const Output d;
+    prm.enter_subsection("Output");
+    prm.declare_entry("Directory",
+                      d.directory,
+                      Patterns::DirectoryName(),
+                      "Where every output file goes; created if missing.");
+    prm.declare_entry("Write vtu",
+                      "true",
+                      Patterns::Bool(),
+                      "Write .pvtu/.vtu fields (velocity, pressure, "
+                      "vorticity, rank, level) and a .pvd index.");
+    prm.declare_entry("Interval steps",
+                      "0",
+                      Patterns::Integer(0),
+                      "Write fields and probes every this many steps (0: "
+                      "off).");
+    prm.declare_entry("Interval time",
+                      "0",
+                      Patterns::Double(0., Patterns::Double::max_double_value),
+                      "Write fields and probes every this much simulated "
+                      "time (0: off). Initial and final states are always "
+                      "written.");
+    prm.declare_entry("Probe points",
+                      "",
+                      Patterns::Anything(),
+                      "Points where velocity and pressure are recorded at "
+                      "every output: coordinates separated by ',', points "
+                      "by ';'.");
+    prm.declare_entry("Progress interval",
+                      std::to_string(d.progress_interval),
+                      Patterns::Integer(0),
+                      "Print one progress line (step, time, dt, ETA) every "
+                      "this many steps (0: never).");
+    prm.declare_entry("Timer summary",
+                      "true",
+                      Patterns::Bool(),
+                      "Print the TimerOutput summary at the end.");
+    prm.leave_subsection();
+  }
+
+  void Output::parse(ParameterHandler &prm, const unsigned int dim)
+  {
+    prm.enter_subsection("Output");
+    directory         = prm.get("Directory");
+    write_vtu         = prm.get_bool("Write vtu");
+    interval_steps    = prm.get_integer("Interval steps");
+    interval_time     = prm.get_double("Interval time");
+    progress_interval = prm.get_integer("Progress interval");
+    timer_summary     = prm.get_bool("Timer summary");
+    const std::string points = prm.get("Probe points");
+    prm.leave_subsection();
+    probe_points.clear();
+    for (const auto &p : split(points, ';'))
+      {
+        probe_points.push_back(to_doubles("Output/Probe points", p));
+        if (probe_points.back().size() != dim)
+          throw InputError("Output/Probe points",
+                           "point '" + p + "' does not have " +
+                             std::to_string(dim) + " coordinates");
+      }
+  }
+
+  // ------------------------------------------------------------ Verification
+  void Verification::declare(ParameterHandler &prm, const unsigned int dim)
+  {
+    const Verification d;
+    prm.enter_subsection("Verification");
+    prm.declare_entry("Exact solution",
+                      "none",
+                      Patterns::Selection("none|function|channel start-up"),
+                      "Solution the run is compared with: 'function' takes "
+                      "'Exact velocity' and 'Exact pressure'; 'channel "
+                      "start-up' is the Fourier-series solution of flow "
+                      "from rest under a constant pressure gradient.");
+    prm.declare_entry("Function constants",
+                      "",
+                      Patterns::Anything(),
+                      "Constants for the exact-solution expressions.");
+    prm.declare_entry("Exact velocity",
+                      zero_vector(dim),
+                      Patterns::Anything(),
+                      "Exact velocity, one expression of x, y[, z], t per "
+                      "component separated by ';'.");
+    prm.declare_entry("Exact pressure",
+                      "0",
+                      Patterns::Anything(),
+                      "Exact pressure (compared up to its mean).");
+    prm.declare_entry("Report times",
+                      "",
+                      Patterns::List(Patterns::Double(0.)),
+                      "Times at which errors are printed, in addition to "
+                      "the end of the run.");
+    prm.declare_entry("Reference data",
+                      "none",
+                      Patterns::Selection("none|Ghia Re100"),
+                      "Published data the final state is compared with: "
+                      "Ghia, Ghia & Shin (1982) lid-driven cavity centre "
+                      "lines at Re = 100 (unit square, lid at y = 1).");
+    prm.declare_entry("Refinement cycles",
+                      "1",
+                      Patterns::Integer(1, 8),
+                      "Repeat the run this many times, one global "
+                      "refinement more each time, and print a convergence "
+                      "table.");
+    prm.declare_entry("Time step cycles",
+                      "1",
+                      Patterns::Integer(1, 8),
+                      "Repeat the run this many times, halving the time step "
+                      "each time, and print a convergence table.");
+    prm.leave_subsection();
+  }
+
+  void Verification::parse(ParameterHandler &prm, const unsigned int dim)
+  {
+    prm.enter_subsection("Verification");
+    const std::string t = prm.get("Exact solution");
+    exact_solution = t == "none"     ? ExactSolutionType::none :
+                     t == "function" ? ExactSolutionType::function :
+                                       ExactSolutionType::channel_startup;
+    exact_velocity = {prm.get("Exact velocity"), prm.get("Function constants")};
+    exact_pressure = prm.get("Exact pressure");
+    report_times   = to_doubles("Verification/Report times",
+                              prm.get("Report times"));
+    reference_data = prm.get("Reference data") == "none" ?
+                       ReferenceData::none :
+                       ReferenceData::ghia_re100;
+    refinement_cycles = prm.get_integer("Refinement cycles");
+    time_step_cycles  = prm.get_integer("Time step cycles");
+    prm.leave_subsection();
+    if (exact_solution == ExactSolutionType::function)
+      {
+        check_expression("Verification/Exact velocity", exact_velocity, dim, dim);
+        check_expression("Verification/Exact pressure",
+                         {exact_pressure, exact_velocity.constants},
+                         1,
+                         dim);
+      }
+    if (refinement_cycles > 1 && time_step_cycles > 1)
+      throw InputError("Verification/Time step cycles",
+                       "a study refines either the mesh or the time step, "
+                       "not both");
+  }
+
+  // --------------------------------------------------------------------- All
+  void All::declare(ParameterHandler &prm, const unsigned int dim)
+  {
+    prm.declare_entry("Dimension",
+                      "2",
+                      Patterns::Integer(2, 3),
+                      "Space dimension of the scene: 2 or 3.");
+    Geometry::declare(prm, dim);
+    Mesh::declare(prm);
+    BoundaryConditions::declare(prm, dim);
+    FlowDriving::declare(prm, dim);
+    Material::declare(prm);
+    InitialConditions::declare(prm, dim);
+    FluidSolver::declare(prm);
+    TimeStepping::declare(prm);
+    Output::declare(prm);
+    Verification::declare(prm, dim);
+  }
+
+  void All::parse(ParameterHandler &prm, const unsigned int dim)
+  {
+    dimension = prm.get_integer("Dimension");
+    geometry.parse(prm, dim);
+    mesh.parse(prm, dim);
+    boundary_conditions.parse(prm, dim);
+    flow_driving.parse(prm, dim);
+    material.parse(prm);
+    initial_conditions.parse(prm, dim);
+    fluid_solver.parse(prm);
+    time_stepping.parse(prm);
+    output.parse(prm, dim);
+    verification.parse(prm, dim);
+
+    if (geometry.type == GeometryType::channel)
+      for (unsigned int d = 0; d + 1 < dim; ++d)
+        boundary_conditions.type[2 * d] = boundary_conditions.type[2 * d + 1] =
+          BoundaryType::periodic;
+    if (flow_driving.type != FlowDrivingType::none &&
+        boundary_conditions.type[0] != BoundaryType::periodic)
+      throw InputError("Flow driving/Type",
+                       "a mean pressure gradient drives flow in x and needs "
+                       "periodic x faces");
+  }
+
+  unsigned int read_dimension(const std::string &filename)
+  {
+    ParameterHandler prm;
+    prm.declare_entry("Dimension", "2", Patterns::Integer(2, 3), "");
+    prm.parse_input(filename, "", /*skip_undefined=*/true);
+    return prm.get_integer("Dimension");
+  }
+
+  All read(const std::string &filename, const unsigned int dim)
+  {
+    ParameterHandler prm;
+    All::declare(prm, dim);
+    prm.parse_input(filename);
+    All all;
+    all.parse(prm, dim);
+    all.input_file = filename;
+    return all;
+  }
+} // namespace Suspension::Parameters

@@ -1,0 +1,308 @@
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/utilities.h>
+
+#include <suspension/core/simulation.h>
+#include <suspension/fluid/body_force.h>
+#include <suspension/postprocess/point_values.h>
+
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <sstream>
+
+namespace Suspension
+{
+  namespace
+  {
+    std::string format_duration(const double seconds)
+    {
+      const long s = std::lround(std::max(0., seconds));
+      std::ostringstream out;
+      out << s / 3600 << "h" << std::setw(2) << std::setfill('0') << (s / 60) % 60 << "m"
+          << std::setw(2) << s % 60 << "s";
+      return out.str();
+    }
+  } // namespace
+
+  template <int dim>
+  Simulation<dim>::Simulation(const Parameters::All &parameters, MPI_Comm communicator)
+    : parameters(parameters)
+    , communicator(communicator)
+    , pcout(std::cout, Utilities::MPI::this_mpi_process(communicator) == 0)
+    , timer(communicator, pcout,
+            parameters.output.timer_summary ? TimerOutput::summary : TimerOutput::never,
+            TimerOutput::wall_times)
+    , triangulation(communicator,
+                    Triangulation<dim>::limit_level_difference_at_vertices,
+                    parallel::distributed::Triangulation<dim>::default_setting)
+    , scene(parameters)
+    , space(triangulation, parameters.fluid_solver.velocity_degree,
+            parameters.fluid_solver.pressure_degree)
+    , fluid(parameters, scene, space, operators)
+    , field_output(parameters.output.directory)
+    , verification(parameters)
+  {
+    if (!parameters.flow_driving.body_force.is_zero())
+      body_force = std::make_unique<Fluid::BodyForce<dim>>(
+        make_function<dim>(parameters.flow_driving.body_force, dim));
+  }
+
+  template <int dim>
+  void Simulation<dim>::setup()
+  {
+    TimerOutput::Scope scope(timer, "setup (mesh, DoFs, matrices)");
+    scene.create_mesh(triangulation);
+    space.setup(scene);
+    operators.reinit(space);
+    fluid.initialize();
+  }
+
+  template <int dim>
+  double Simulation<dim>::choose_time_step(const double dt, const double time,
+                                           const Fluid::FlowDiagnostics &d) const
+  {
+    const auto &ts   = parameters.time_stepping;
+    double      next = dt;
+    if (ts.adaptive && d.max_speed_over_h > 0.)
+      {
+        // A new step size means a new momentum matrix and preconditioner:
+        // change only when the CFL number leaves [0.5, 1] x target.
+        const double cfl = dt * d.max_speed_over_h;
+        if (cfl > ts.cfl || cfl < 0.5 * ts.cfl)
+          next = std::min(ts.maximum_time_step, 0.9 * ts.cfl / d.max_speed_over_h);
+      }
+    // Land exactly on report times and on the end time.
+    std::vector<double> targets = parameters.verification.report_times;
+    targets.push_back(ts.end_time);
+    for (const double target : targets)
+      if (target > time + 1e-12 * next && target < time + next * (1. + 1e-9))
+        return target - time;
+    return next;
+  }
+
+  template <int dim>
+  bool Simulation<dim>::output_due(const double time, const double dt) const
+  {
+    const auto &o = parameters.output;
+    if (o.interval_steps > 0 && fluid.step_number() % o.interval_steps == 0)
+      return true;
+    if (o.interval_time > 0 && time >= last_output_time + o.interval_time - 1e-9 * dt)
+      return true;
+    return false;
+  }
+
+  template <int dim>
+  void Simulation<dim>::write_output()
+  {
+    TimerOutput::Scope scope(timer, "output");
+    last_output_time = fluid.time();
+    if (parameters.output.write_vtu)
+      field_output.write(space, fluid.velocity(), fluid.kinematic_pressure(),
+                         parameters.material.density, fluid.time());
+    write_probes();
+  }
+
+  template <int dim>
+  void Simulation<dim>::write_probes()
+  {
+    const auto &coordinates = parameters.output.probe_points;
+    if (coordinates.empty())
+      return;
+    std::vector<Point<dim>> points;
+    for (const auto &c : coordinates)
+      {
+        Point<dim> p;
+        for (unsigned int d = 0; d < dim; ++d)
+          p[d] = c[d];
+        points.push_back(p);
+      }
+    const auto u = Postprocess::point_values(space.dof_velocity, fluid.velocity(), points);
+    const auto p = Postprocess::point_values(space.dof_pressure, fluid.kinematic_pressure(), points);
+    static const char *names[] = {"u_x", "u_y", "u_z"};
+    for (unsigned int k = 0; k < points.size(); ++k)
+      {
+        probes.add_value("time", fluid.time());
+        probes.add_value("probe", k);
+        for (unsigned int d = 0; d < dim; ++d)
+          probes.add_value("x" + std::to_string(d), points[k][d]);
+        for (unsigned int d = 0; d < dim; ++d)
+          probes.add_value(names[d], u[k][d]);
+        probes.add_value("p", parameters.material.density * p[k][0]);
+      }
+  }
+
+  template <int dim>
+  void Simulation<dim>::add_statistics_row(const Fluid::StepReport      &r,
+                                           const Fluid::FlowDiagnostics &d,
+                                           const double                  dt,
+                                           const double                  wall_time)
+  {
+    statistics.add_value("step", fluid.step_number());
+    statistics.add_value("time", fluid.time());
+    statistics.add_value("dt", dt);
+    statistics.add_value("CFL", dt * d.max_speed_over_h);
+    statistics.add_value("bulk_velocity", d.bulk_velocity);
+    statistics.add_value("minus_dp_dx", r.driving_force);
+    statistics.add_value("kinetic_energy", d.kinetic_energy);
+    statistics.add_value("div_u_L2", d.divergence_l2);
+    statistics.add_value("its_momentum", r.momentum_iterations);
+    statistics.add_value("its_projection", r.projection_iterations);
+    statistics.add_value("its_mass", r.mass_iterations);
+    statistics.add_value("cells", triangulation.n_global_active_cells());
+    statistics.add_value("dofs", space.dof_velocity.n_dofs() + space.dof_pressure.n_dofs());
+    statistics.add_value("wall_time_step", wall_time);
+    for (const auto &c : {"time", "dt", "CFL", "bulk_velocity", "minus_dp_dx",
+                          "kinetic_energy", "div_u_L2", "wall_time_step"})
+      {
+        statistics.set_scientific(c, true);
+        statistics.set_precision(c, 8);
+      }
+  }
+
+  template <int dim>
+  void Simulation<dim>::write_tables() const
+  {
+    if (Utilities::MPI::this_mpi_process(communicator) != 0)
+      return;
+    std::ofstream stats(parameters.output.directory + "/statistics.txt");
+    statistics.write_text(stats, TableHandler::table_with_separate_column_description);
+    if (!parameters.output.probe_points.empty())
+      {
+        std::ofstream out(parameters.output.directory + "/probes.txt");
+        TableHandler  copy = probes;
+        for (const auto &c : {"time", "x0", "x1", "x2", "u_x", "u_y", "u_z", "p"})
+          if (dim == 3 || (std::string(c) != "x2" && std::string(c) != "u_z"))
+            {
+              copy.set_scientific(c, true);
+              copy.set_precision(c, 10);
+            }
+        copy.write_text(out, TableHandler::table_with_separate_column_description);
+      }
+  }
+
+  template <int dim>
+  void Simulation<dim>::report_errors(const double time)
+  {
+    if (!verification.has_exact_solution())
+      return;
+    last_errors = verification.errors(space, fluid.velocity(), fluid.kinematic_pressure(), time);
+    pcout << "  t = " << std::defaultfloat << std::setprecision(6) << time
+          << ": velocity L2 error " << std::scientific << std::setprecision(3)
+          << last_errors.velocity_l2 << " (relative " << last_errors.velocity_l2_relative
+          << "), pressure L2 error " << last_errors.pressure_l2 << std::defaultfloat
+          << std::endl;
+  }
+
+  template <int dim>
+  void Simulation<dim>::print_progress(const double dt, const Fluid::FlowDiagnostics &d,
+                                       const double elapsed) const
+  {
+    const double t = fluid.time(), end = parameters.time_stepping.end_time;
+    pcout << "step " << std::setw(6) << fluid.step_number() << "  t = " << std::scientific
+          << std::setprecision(3) << t << " / " << end << "  dt = " << dt << "  CFL "
+          << std::fixed << std::setprecision(2) << dt * d.max_speed_over_h << "  ETA "
+          << format_duration(t > 0 ? elapsed / t * (end - t) : 0.) << std::defaultfloat
+          << std::endl;
+  }
+
+  template <int dim>
+  RunSummary Simulation<dim>::run()
+  {
+    if (Utilities::MPI::this_mpi_process(communicator) == 0)
+      std::filesystem::create_directories(parameters.output.directory);
+    setup();
+    pcout << "  " << dim << "D, " << triangulation.n_global_active_cells() << " cells, "
+          << space.dof_velocity.n_dofs() << " velocity + " << space.dof_pressure.n_dofs()
+          << " pressure DoFs" << std::endl;
+
+    std::vector<const Fluid::MomentumSource<dim> *> sources;
+    if (body_force)
+      sources.push_back(body_force.get());
+
+    const auto &ts      = parameters.time_stepping;
+    double      dt      = ts.time_step;
+    auto        diagnostics = fluid.compute_diagnostics();
+    write_output();
+
+    std::vector<double> report_times = parameters.verification.report_times;
+    const auto          start        = std::chrono::steady_clock::now();
+    bool                steady       = false;
+    while (fluid.time() < ts.end_time * (1. - 1e-12) && !steady &&
+           (ts.maximum_steps == 0 || fluid.step_number() < ts.maximum_steps))
+      {
+        const auto step_start = std::chrono::steady_clock::now();
+        dt = choose_time_step(dt, fluid.time(), diagnostics);
+
+        Fluid::StepReport report;
+        {
+          TimerOutput::Scope scope(timer, "fluid step");
+          report = fluid.advance(dt, sources);
+        }
+        {
+          TimerOutput::Scope scope(timer, "diagnostics");
+          diagnostics = fluid.compute_diagnostics();
+        }
+        if (!std::isfinite(diagnostics.kinetic_energy))
+          {
+            write_output();
+            write_tables();
+            throw std::runtime_error("the velocity is not finite (NaN or Inf) at t = " +
+                                     std::to_string(fluid.time()) +
+                                     "; reduce the time step or the CFL number");
+          }
+        steady = ts.steady_tolerance > 0 && fluid.relative_change_rate() < ts.steady_tolerance;
+
+        const double wall =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count();
+        add_statistics_row(report, diagnostics, dt, wall);
+
+        for (const double t : report_times)
+          if (std::abs(t - fluid.time()) < 1e-9 * dt)
+            report_errors(fluid.time());
+        if (output_due(fluid.time(), dt))
+          write_output();
+        const auto &o = parameters.output;
+        if (o.progress_interval > 0 && fluid.step_number() % o.progress_interval == 0)
+          {
+            print_progress(dt, diagnostics,
+                           std::chrono::duration<double>(std::chrono::steady_clock::now() - start)
+                             .count());
+            write_tables();
+          }
+      }
+    if (steady)
+      pcout << "  steady state reached" << std::endl;
+    if (last_output_time != fluid.time())
+      write_output();
+    write_tables();
+
+    report_errors(fluid.time());
+    if (parameters.verification.reference_data == Parameters::ReferenceData::ghia_re100)
+      {
+        const auto c = verification.compare_with_ghia(space, fluid.velocity());
+        pcout << "  Ghia et al. (1982), Re = 100: max |u - u_ref| on x = 1/2: " << std::fixed
+              << std::setprecision(3) << c.max_u_deviation << ", max |v - v_ref| on y = 1/2: "
+              << c.max_v_deviation << std::defaultfloat << std::endl;
+        pcout << "  within 2% of the lid speed: "
+              << (std::max(c.max_u_deviation, c.max_v_deviation) <= 0.02 ? "yes" : "no")
+              << std::endl;
+      }
+
+    RunSummary summary;
+    summary.final_errors = last_errors;
+    double h = std::numeric_limits<double>::max();
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+        h = std::min(h, cell->minimum_vertex_distance());
+    summary.smallest_cell = Utilities::MPI::min(h, communicator);
+    summary.time_step     = dt;
+    summary.n_steps       = fluid.step_number();
+    summary.n_dofs        = space.dof_velocity.n_dofs() + space.dof_pressure.n_dofs();
+    return summary;
+  }
+
+  template class Simulation<2>;
+  template class Simulation<3>;
+} // namespace Suspension

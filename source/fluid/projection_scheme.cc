@@ -1,0 +1,317 @@
+#include <deal.II/base/mpi.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/lac/full_matrix.h>
+#include <deal.II/numerics/vector_tools.h>
+
+#include <suspension/fluid/projection_scheme.h>
+
+namespace Suspension::Fluid
+{
+  template <int dim>
+  ProjectionScheme<dim>::ProjectionScheme(const Parameters::All &parameters,
+                                          const Scene<dim>      &scene,
+                                          const FluidSpace<dim> &space,
+                                          FluidOperators<dim>   &operators)
+    : parameters(parameters)
+    , scene(scene)
+    , space(space)
+    , operators(operators)
+    , nu(parameters.material.viscosity / parameters.material.density)
+  {}
+
+  template <int dim>
+  void ProjectionScheme<dim>::initialize()
+  {
+    const MPI_Comm comm = space.communicator();
+    for (auto *v : {&u, &u_old, &u_older, &unit_response, &rhs_u})
+      v->reinit(space.owned_velocity, comm);
+    for (auto *v : {&p, &psi, &psi_old, &div_u, &div_u_load, &rhs_p})
+      v->reinit(space.owned_pressure, comm);
+    for (auto *v : {&velocity_ghosted, &u_star_ghosted, &u_history_ghosted})
+      v->reinit(space.owned_velocity, space.relevant_velocity, comm);
+    for (auto *v : {&pressure_ghosted, &p_sharp_ghosted})
+      v->reinit(space.owned_pressure, space.relevant_pressure, comm);
+
+    scene.set_time(0.);
+    VectorTools::interpolate(space.dof_velocity, scene.initial_velocity(), u);
+    space.make_velocity_constraints(scene, false, step_constraints);
+    step_constraints.distribute(u);
+    u_old = u;
+    u_older = u;
+    velocity_ghosted = u;
+    pressure_ghosted = p;
+    current_time = 0.;
+    last_dt      = 0.;
+    n_steps      = 0;
+  }
+
+  template <int dim>
+  double ProjectionScheme<dim>::flux(const VectorType &v) const
+  {
+    return operators.flux_weights * v;
+  }
+
+  template <int dim>
+  void ProjectionScheme<dim>::update_unit_response()
+  {
+    VectorType b(operators.unit_force);
+    b /= parameters.material.density;
+    unit_response = 0.;
+    operators.solve_momentum(unit_response, b, parameters.fluid_solver.solver_tolerance);
+    space.velocity_constraints.distribute(unit_response);
+  }
+
+  template <int dim>
+  StepReport
+  ProjectionScheme<dim>::advance(const double dt,
+                                 const std::vector<const MomentumSource<dim> *> &sources)
+  {
+    StepReport report;
+    const double t_new = current_time + dt;
+
+    // BDF coefficients: BDF1 on the first step, variable-step BDF2 after.
+    double extrapolation = 0.;
+    if (n_steps == 0)
+      {
+        alpha = 1.; beta_1 = 1.; beta_2 = 0.;
+      }
+    else
+      {
+        const double w = dt / last_dt;
+        alpha  = (1. + 2. * w) / (1. + w);
+        beta_1 = 1. + w;
+        beta_2 = w * w / (1. + w);
+        extrapolation = w;
+      }
+
+    // Constant matrices change only with alpha / dt (and the mesh).
+    const double old_alpha_over_dt = operators.momentum_alpha_over_dt;
+    operators.set_momentum_coefficients(alpha / dt, nu);
+    if (operators.momentum_alpha_over_dt != old_alpha_over_dt)
+      {
+        report.matrices_rebuilt = true;
+        if (parameters.flow_driving.type != Parameters::FlowDrivingType::none)
+          update_unit_response();
+      }
+
+    // Extrapolated velocity (convection), history (time derivative) and
+    // pressure P# = P^n + (4 psi^n - psi^{n-1}) / 3.
+    u_older = u_old;
+    u_old   = u;
+    {
+      VectorType tmp(u_old);
+      tmp *= 1. + extrapolation;
+      tmp.add(-extrapolation, u_older);
+      u_star_ghosted = tmp;
+      tmp = u_old;
+      tmp *= beta_1 / dt;
+      tmp.add(-beta_2 / dt, u_older);
+      u_history_ghosted = tmp;
+      VectorType ps(p);
+      if (n_steps > 0)
+        {
+          ps.add(4. / 3., psi);
+          ps.add(-1. / 3., psi_old);
+        }
+      p_sharp_ghosted = ps;
+    }
+
+    // 1. momentum predictor
+    scene.set_time(t_new);
+    space.make_velocity_constraints(scene, false, step_constraints);
+    assemble_momentum_rhs(dt, t_new, sources);
+    report.momentum_iterations =
+      operators.solve_momentum(u, rhs_u, parameters.fluid_solver.solver_tolerance);
+    step_constraints.distribute(u);
+
+    // 2. flow-rate control by linearity
+    const auto &driving = parameters.flow_driving;
+    if (driving.type == Parameters::FlowDrivingType::constant_flow_rate)
+      {
+        const double target = driving.bulk_velocity * scene.volume();
+        report.driving_force = (target - flux(u)) / flux(unit_response);
+        u.add(report.driving_force, unit_response);
+      }
+    else if (driving.type == Parameters::FlowDrivingType::constant_pressure_gradient)
+      {
+        report.driving_force = driving.pressure_gradient;
+        u.add(report.driving_force, unit_response);
+      }
+
+    // 3. projection: the increment psi
+    operators.D.vmult(div_u_load, u);
+    rhs_p = div_u_load;
+    rhs_p *= -alpha / dt;
+    space.increment_constraints.set_zero(rhs_p);
+    psi_old = psi;
+    report.projection_iterations =
+      operators.solve_pressure_laplace(psi, rhs_p, parameters.fluid_solver.solver_tolerance);
+    space.increment_constraints.distribute(psi);
+
+    // 4. pressure update; Pi div u is also the divergence diagnostic
+    report.mass_iterations =
+      operators.solve_pressure_mass(div_u, div_u_load, parameters.fluid_solver.solver_tolerance);
+    space.pressure_constraints.distribute(div_u);
+    p.add(1., psi);
+    if (parameters.fluid_solver.projection == Parameters::ProjectionForm::rotational)
+      p.add(-nu, div_u);
+
+    {
+      VectorType change(u);
+      change.add(-1., u_old);
+      const double umax = u.linfty_norm();
+      last_change_rate  = umax > 0 ? change.linfty_norm() / (dt * umax) : 0.;
+    }
+
+    velocity_ghosted = u;
+    pressure_ghosted = p;
+    current_time     = t_new;
+    last_dt          = dt;
+    ++n_steps;
+    return report;
+  }
+
+  template <int dim>
+  void ProjectionScheme<dim>::assemble_momentum_rhs(
+    const double dt, const double t_new,
+    const std::vector<const MomentumSource<dim> *> &sources)
+  {
+    (void)dt;
+    rhs_u = 0.;
+    const bool convection =
+      parameters.fluid_solver.convection != Parameters::ConvectionForm::none;
+    bool any_stress = false;
+    for (const auto *s : sources)
+      any_stress = any_stress || s->has_stress();
+
+    const FEValuesExtractors::Vector velocities(0);
+    FEValues<dim> fe_u(space.fe_velocity, space.quadrature,
+                       update_values | update_gradients | update_JxW_values |
+                         update_quadrature_points);
+    FEValues<dim> fe_p(space.fe_pressure, space.quadrature, update_gradients);
+
+    const unsigned int nu_dofs = space.fe_velocity.n_dofs_per_cell();
+    const unsigned int n_q     = space.quadrature.size();
+    Vector<double>                       cell_rhs(nu_dofs);
+    FullMatrix<double>                   cell_matrix(nu_dofs, nu_dofs);
+    std::vector<types::global_dof_index> dofs(nu_dofs);
+    std::vector<Tensor<1, dim>>          history(n_q), u_star(n_q), grad_p(n_q), force(n_q);
+    std::vector<Tensor<2, dim>>          grad_u_star(n_q);
+    std::vector<SymmetricTensor<2, dim>> stress(n_q);
+    std::vector<unsigned int>            component(nu_dofs);
+    for (unsigned int i = 0; i < nu_dofs; ++i)
+      component[i] = space.fe_velocity.system_to_component_index(i).first;
+    const double inv_rho = 1. / parameters.material.density;
+
+    for (const auto &cell : space.dof_velocity.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          fe_u.reinit(cell);
+          fe_p.reinit(FluidSpace<dim>::cell_of(cell, space.dof_pressure));
+          fe_u[velocities].get_function_values(u_history_ghosted, history);
+          fe_p.get_function_gradients(p_sharp_ghosted, grad_p);
+          if (convection)
+            {
+              fe_u[velocities].get_function_values(u_star_ghosted, u_star);
+              fe_u[velocities].get_function_gradients(u_star_ghosted, grad_u_star);
+            }
+          std::fill(force.begin(), force.end(), Tensor<1, dim>());
+          std::fill(stress.begin(), stress.end(), SymmetricTensor<2, dim>());
+          for (const auto *s : sources)
+            s->add(cell, fe_u.get_quadrature_points(),
+                   space.quadrature.get_points(), t_new, force, stress);
+
+          // The whole right-hand side as one vector per point:
+          // history - convection - grad P# + f / rho.
+          for (unsigned int q = 0; q < n_q; ++q)
+            {
+              force[q] = force[q] * inv_rho + history[q] - grad_p[q];
+              if (convection)
+                force[q] -= grad_u_star[q] * u_star[q] +
+                            0.5 * trace(grad_u_star[q]) * u_star[q];
+            }
+
+          cell_rhs = 0;
+          for (unsigned int q = 0; q < n_q; ++q)
+            {
+              const double         JxW = fe_u.JxW(q);
+              const Tensor<2, dim> tau = inv_rho * Tensor<2, dim>(stress[q]);
+              for (unsigned int i = 0; i < nu_dofs; ++i)
+                {
+                  const unsigned int c = component[i];
+                  double value = force[q][c] * fe_u.shape_value(i, q);
+                  if (any_stress)
+                    value -= tau[c] * fe_u.shape_grad(i, q);
+                  cell_rhs(i) += value * JxW;
+                }
+            }
+
+          cell->get_dof_indices(dofs);
+          bool inhomogeneous = false;
+          for (const auto i : dofs)
+            inhomogeneous = inhomogeneous || step_constraints.is_inhomogeneously_constrained(i);
+          if (inhomogeneous)
+            {
+              // Lift the boundary data: the cell matrix moves A g to the
+              // right-hand side (Dirichlet columns are not in A).
+              cell_matrix = 0;
+              for (unsigned int q = 0; q < n_q; ++q)
+                for (unsigned int i = 0; i < nu_dofs; ++i)
+                  for (unsigned int j = 0; j < nu_dofs; ++j)
+                    if (component[i] == component[j])
+                      cell_matrix(i, j) +=
+                        (operators.momentum_alpha_over_dt * fe_u.shape_value(i, q) *
+                           fe_u.shape_value(j, q) +
+                         nu * fe_u.shape_grad(i, q) * fe_u.shape_grad(j, q)) *
+                        fe_u.JxW(q);
+              step_constraints.distribute_local_to_global(cell_rhs, dofs, rhs_u, cell_matrix);
+            }
+          else
+            step_constraints.distribute_local_to_global(cell_rhs, dofs, rhs_u);
+        }
+    rhs_u.compress(VectorOperation::add);
+  }
+
+  template <int dim>
+  FlowDiagnostics ProjectionScheme<dim>::compute_diagnostics() const
+  {
+    FlowDiagnostics d;
+    const FEValuesExtractors::Vector velocities(0);
+    FEValues<dim> fe_u(space.fe_velocity, space.quadrature, update_values | update_JxW_values);
+    std::vector<Tensor<1, dim>> values(space.quadrature.size());
+    const double degree = space.fe_velocity.degree;
+    double energy = 0., speed_over_h = 0., speed = 0.;
+    for (const auto &cell : space.dof_velocity.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          fe_u.reinit(cell);
+          fe_u[velocities].get_function_values(velocity_ghosted, values);
+          double cell_speed = 0.;
+          for (const unsigned int q : fe_u.quadrature_point_indices())
+            {
+              energy += values[q].norm_square() * fe_u.JxW(q);
+              cell_speed = std::max(cell_speed, values[q].norm());
+            }
+          speed = std::max(speed, cell_speed);
+          speed_over_h = std::max(speed_over_h,
+                                  cell_speed * degree / cell->minimum_vertex_distance());
+        }
+    const MPI_Comm comm = space.communicator();
+    d.kinetic_energy   = 0.5 * parameters.material.density * Utilities::MPI::sum(energy, comm);
+    d.max_speed_over_h = Utilities::MPI::max(speed_over_h, comm);
+    d.max_speed        = Utilities::MPI::max(speed, comm);
+    d.bulk_velocity    = flux(u) / scene.volume();
+    // (Pi div u, div u) = ||Pi div u||^2, from the condensed load D u
+    d.divergence_l2 = std::sqrt(std::max(0., div_u_load * div_u));
+    return d;
+  }
+
+  template <int dim>
+  double ProjectionScheme<dim>::relative_change_rate() const
+  {
+    return last_change_rate;
+  }
+
+  template class ProjectionScheme<2>;
+  template class ProjectionScheme<3>;
+} // namespace Suspension::Fluid
