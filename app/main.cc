@@ -41,10 +41,7 @@ int main(int argc, char *argv[])
   const std::vector<std::string> args(argv + 1, argv + argc);
 
   if (args.empty())
-    {
-      std::cerr << usage;
-      return fail("no parameter file given");
-    }
+    return fail("no parameter file given (suspension --help for usage)");
   if (args[0] == "--help" || args[0] == "-h")
     {
       std::cout << usage;
@@ -66,10 +63,7 @@ int main(int argc, char *argv[])
       return 0;
     }
   if (args[0].rfind("--", 0) == 0)
-    {
-      std::cerr << usage;
-      return fail("unknown option '" + args[0] + "'");
-    }
+    return fail("unknown option '" + args[0] + "' (suspension --help for usage)");
 
   const std::string filename = args[0];
   Parameters::All   parameters;

@@ -4,6 +4,8 @@
 #include <suspension/core/parameters.h>
 
 #include <fstream>
+#include <iostream>
+#include <sstream>
 
 namespace Suspension::Parameters
 {
@@ -50,20 +52,31 @@ namespace Suspension::Parameters
                          "expected " + std::to_string(n_components) +
                            " component(s) separated by ';', found " +
                            std::to_string(parts.size()));
+      const auto constants = f.constant_map();
+      // deal.II echoes muparser's message to std::cerr before throwing:
+      // silence it, the InputError below says it in one line.
+      std::ostringstream  muted;
+      std::streambuf     *cerr_buffer = std::cerr.rdbuf(muted.rdbuf());
+      struct Restore
+      {
+        std::streambuf *buffer;
+        ~Restore() { std::cerr.rdbuf(buffer); }
+      } restore{cerr_buffer};
       try
         {
+          // FunctionParser parses lazily: evaluate once to find errors now.
           if (dim == 2)
-            FunctionParser<2>(n_components)
-              .initialize(variable_names(2),
-                          f.expression,
-                          f.constant_map(),
-                          true);
+            {
+              FunctionParser<2> parser(n_components);
+              parser.initialize(variable_names(2), f.expression, constants, true);
+              parser.value(Point<2>());
+            }
           else
-            FunctionParser<3>(n_components)
-              .initialize(variable_names(3),
-                          f.expression,
-                          f.constant_map(),
-                          true);
+            {
+              FunctionParser<3> parser(n_components);
+              parser.initialize(variable_names(3), f.expression, constants, true);
+              parser.value(Point<3>());
+            }
         }
       catch (...)
         {
@@ -188,6 +201,7 @@ namespace Suspension::Parameters
       throw InputError("Geometry/Subdivisions",
                        "give one count per direction (" + std::to_string(dim) +
                          ") or leave empty");
+    subdivisions_given = !subdivisions.empty();
     if (subdivisions.empty())
       {
         double shortest = box_upper[0] - box_lower[0];
@@ -615,6 +629,23 @@ namespace Suspension::Parameters
                       "Published data the final state is compared with: "
                       "Ghia, Ghia & Shin (1982) lid-driven cavity centre "
                       "lines at Re = 100 (unit square, lid at y = 1).");
+    prm.declare_entry("Tolerance",
+                      "0",
+                      Patterns::Double(0.),
+                      "If positive, the final relative velocity error (and, "
+                      "for a channel at constant flow rate, the relative "
+                      "deviation of -dp/dx from the laminar 3 mu V_b / h^2) "
+                      "is checked against it and the verdict printed.");
+    prm.declare_entry("Minimum velocity rate",
+                      "0",
+                      Patterns::Double(0.),
+                      "If positive, a study checks that the velocity L2 "
+                      "error falls at least at this rate between its last "
+                      "two cycles and prints the verdict.");
+    prm.declare_entry("Minimum pressure rate",
+                      "0",
+                      Patterns::Double(0.),
+                      "The same for the pressure L2 error.");
     prm.declare_entry("Refinement cycles",
                       "1",
                       Patterns::Integer(1, 8),
@@ -643,6 +674,9 @@ namespace Suspension::Parameters
     reference_data = prm.get("Reference data") == "none" ?
                        ReferenceData::none :
                        ReferenceData::ghia_re100;
+    tolerance         = prm.get_double("Tolerance");
+    minimum_velocity_rate = prm.get_double("Minimum velocity rate");
+    minimum_pressure_rate = prm.get_double("Minimum pressure rate");
     refinement_cycles = prm.get_integer("Refinement cycles");
     time_step_cycles  = prm.get_integer("Time step cycles");
     prm.leave_subsection();
@@ -697,6 +731,18 @@ namespace Suspension::Parameters
       for (unsigned int d = 0; d + 1 < dim; ++d)
         boundary_conditions.type[2 * d] = boundary_conditions.type[2 * d + 1] =
           BoundaryType::periodic;
+    // p4est cannot make a coarse cell its own periodic neighbour.
+    for (unsigned int d = 0; d < dim; ++d)
+      if (boundary_conditions.type[2 * d] == BoundaryType::periodic &&
+          geometry.subdivisions[d] < 2)
+        {
+          if (!geometry.subdivisions_given)
+            for (auto &n : geometry.subdivisions)
+              n *= 2;
+          else
+            throw InputError("Geometry/Subdivisions",
+                             "a periodic direction needs at least 2 base cells");
+        }
     if (flow_driving.type != FlowDrivingType::none &&
         boundary_conditions.type[0] != BoundaryType::periodic)
       throw InputError("Flow driving/Type",

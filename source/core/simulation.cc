@@ -44,6 +44,7 @@ namespace Suspension
     , field_output(parameters.output.directory)
     , verification(parameters)
   {
+    fluid.set_timer(timer);
     if (!parameters.flow_driving.body_force.is_zero())
       body_force = std::make_unique<Fluid::BodyForce<dim>>(
         make_function<dim>(parameters.flow_driving.body_force, dim));
@@ -121,8 +122,16 @@ namespace Suspension
     const auto u = Postprocess::point_values(space.dof_velocity, fluid.velocity(), points);
     const auto p = Postprocess::point_values(space.dof_pressure, fluid.kinematic_pressure(), points);
     static const char *names[] = {"u_x", "u_y", "u_z"};
+    last_probe_values.clear();
     for (unsigned int k = 0; k < points.size(); ++k)
       {
+        std::ostringstream line;
+        line << "  probe " << k << " at (" << points[k] << "): u = (" << std::scientific
+             << std::setprecision(6);
+        for (unsigned int d = 0; d < dim; ++d)
+          line << (d > 0 ? ", " : "") << u[k][d];
+        line << "), p = " << parameters.material.density * p[k][0];
+        last_probe_values.push_back(line.str());
         probes.add_value("time", fluid.time());
         probes.add_value("probe", k);
         for (unsigned int d = 0; d < dim; ++d)
@@ -183,16 +192,48 @@ namespace Suspension
   }
 
   template <int dim>
-  void Simulation<dim>::report_errors(const double time)
+  void Simulation<dim>::report_errors(const double time, const bool steady)
   {
     if (!verification.has_exact_solution())
       return;
     last_errors = verification.errors(space, fluid.velocity(), fluid.kinematic_pressure(), time);
-    pcout << "  t = " << std::defaultfloat << std::setprecision(6) << time
+    error_history.emplace_back(time, last_errors);
+    std::ostringstream when;
+    when << "t = " << std::setprecision(6) << time;
+    // the step at which a steady state is detected may differ by one
+    // between platforms or rank counts: do not print it
+    pcout << "  " << (steady ? std::string("steady state") : when.str())
           << ": velocity L2 error " << std::scientific << std::setprecision(3)
           << last_errors.velocity_l2 << " (relative " << last_errors.velocity_l2_relative
           << "), pressure L2 error " << last_errors.pressure_l2 << std::defaultfloat
           << std::endl;
+  }
+
+  template <int dim>
+  void Simulation<dim>::report_verdicts(const bool steady)
+  {
+    const double tolerance = parameters.verification.tolerance;
+    const auto   verdict   = [&](const double value) { return value <= tolerance ? "yes" : "no"; };
+    if (tolerance > 0 && verification.has_exact_solution())
+      pcout << "  velocity relative L2 error <= " << tolerance << ": "
+            << verdict(last_errors.velocity_l2_relative) << std::endl;
+
+    // In a channel at constant flow rate, -dp/dx over its laminar value
+    // 3 mu V_b / h^2 is the effective viscosity ratio.
+    const auto &driving = parameters.flow_driving;
+    if (parameters.geometry.type == Parameters::GeometryType::channel &&
+        driving.type == Parameters::FlowDrivingType::constant_flow_rate && steady)
+      {
+        const double h       = parameters.geometry.half_height;
+        const double laminar = 3. * parameters.material.viscosity * driving.bulk_velocity / (h * h);
+        const double ratio   = last_driving_force / laminar;
+        pcout << "  -dp/dx = " << std::setprecision(8) << last_driving_force
+              << ", laminar 3 mu V_b / h^2 = " << laminar << ", ratio " << ratio
+              << std::defaultfloat << std::endl;
+        if (tolerance > 0)
+          pcout << "  |ratio - 1| <= " << tolerance << ": " << verdict(std::abs(ratio - 1.))
+                << std::endl;
+      }
   }
 
   template <int dim>
@@ -236,10 +277,7 @@ namespace Suspension
         dt = choose_time_step(dt, fluid.time(), diagnostics);
 
         Fluid::StepReport report;
-        {
-          TimerOutput::Scope scope(timer, "fluid step");
-          report = fluid.advance(dt, sources);
-        }
+        report = fluid.advance(dt, sources);
         {
           TimerOutput::Scope scope(timer, "diagnostics");
           diagnostics = fluid.compute_diagnostics();
@@ -257,10 +295,11 @@ namespace Suspension
         const double wall =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count();
         add_statistics_row(report, diagnostics, dt, wall);
+        last_driving_force = report.driving_force;
 
         for (const double t : report_times)
           if (std::abs(t - fluid.time()) < 1e-9 * dt)
-            report_errors(fluid.time());
+            report_errors(fluid.time(), false);
         if (output_due(fluid.time(), dt))
           write_output();
         const auto &o = parameters.output;
@@ -278,7 +317,13 @@ namespace Suspension
       write_output();
     write_tables();
 
-    report_errors(fluid.time());
+    pcout << "  final state: kinetic energy " << std::scientific << std::setprecision(6)
+          << diagnostics.kinetic_energy << ", bulk velocity " << diagnostics.bulk_velocity
+          << ", -dp/dx " << last_driving_force << std::defaultfloat << std::endl;
+    for (const auto &line : last_probe_values)
+      pcout << line << std::endl;
+    report_errors(fluid.time(), steady);
+    report_verdicts(steady);
     if (parameters.verification.reference_data == Parameters::ReferenceData::ghia_re100)
       {
         const auto c = verification.compare_with_ghia(space, fluid.velocity());
@@ -292,6 +337,7 @@ namespace Suspension
 
     RunSummary summary;
     summary.final_errors = last_errors;
+    summary.errors       = error_history;
     double h = std::numeric_limits<double>::max();
     for (const auto &cell : triangulation.active_cell_iterators())
       if (cell->is_locally_owned())

@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <iomanip>
+#include <sstream>
 
 namespace Suspension
 {
@@ -18,7 +19,6 @@ namespace Suspension
     const unsigned int cycles = std::max(v.refinement_cycles, v.time_step_cycles);
     const bool         in_space = v.refinement_cycles > 1;
 
-    ConvergenceTable table;
     std::vector<RunSummary> runs;
     for (unsigned int cycle = 0; cycle < cycles; ++cycle)
       {
@@ -29,23 +29,62 @@ namespace Suspension
           p.time_stepping.time_step /= std::pow(2., cycle);
         if (cycles > 1)
           pcout << "cycle " << cycle << ":" << std::endl;
-        Simulation<dim> simulation(p, communicator);
-        const RunSummary r = simulation.run();
+        RunSummary         r;
+        std::exception_ptr failure;
+        {
+          // Let the simulation (and its TimerOutput) end normally before a
+          // failure propagates, so that the error stays one clear line.
+          Simulation<dim> simulation(p, communicator);
+          try
+            {
+              r = simulation.run();
+            }
+          catch (...)
+            {
+              failure = std::current_exception();
+            }
+        }
+        if (failure)
+          std::rethrow_exception(failure);
         runs.push_back(r);
-        if (cycles > 1)
-          {
-            table.add_value(in_space ? "h" : "dt", in_space ? r.smallest_cell : r.time_step);
-            table.add_value("u L2", r.final_errors.velocity_l2);
-            table.add_value("p L2", r.final_errors.pressure_l2);
-          }
       }
     if (cycles == 1)
       return;
 
+    // One velocity (and, where it is not zero, pressure) column per time
+    // at which errors were reported.
     const std::string key = in_space ? "h" : "dt";
+    const auto       &reported = runs.front().errors;
+    double            largest_pressure_error = 0.;
+    for (const auto &r : runs)
+      for (const auto &[t, e] : r.errors)
+        largest_pressure_error = std::max(largest_pressure_error, e.pressure_l2);
+    const bool     with_pressure = largest_pressure_error > 1e-10;
+    ConvergenceTable table;
+    std::vector<std::string> columns;
+    for (const auto &r : runs)
+      {
+        table.add_value(key, in_space ? r.smallest_cell : r.time_step);
+        for (unsigned int k = 0; k < r.errors.size() && k < reported.size(); ++k)
+          {
+            std::ostringstream t;
+            t << std::setprecision(6) << "t=" << reported[k].first;
+            table.add_value("u L2 " + t.str(), r.errors[k].second.velocity_l2);
+            if (k == 0 && &r == &runs.front())
+              columns.push_back("u L2 " + t.str());
+            if (with_pressure)
+              {
+                table.add_value("p L2 " + t.str(), r.errors[k].second.pressure_l2);
+                if (&r == &runs.front())
+                  columns.push_back("p L2 " + t.str());
+              }
+            if (k > 0 && &r == &runs.front())
+              columns.push_back("u L2 " + t.str());
+          }
+      }
     table.set_scientific(key, true);
     table.set_precision(key, 3);
-    for (const auto &c : {"u L2", "p L2"})
+    for (const auto &c : columns)
       {
         table.set_scientific(c, true);
         table.set_precision(c, 3);
@@ -55,15 +94,21 @@ namespace Suspension
     if (Utilities::MPI::this_mpi_process(communicator) == 0)
       table.write_text(std::cout);
 
-    // Rate between the last two cycles, the asymptotic one.
-    const auto rate = [&](const auto error) {
-      const auto &a = runs[runs.size() - 2], &b = runs.back();
-      return std::log2(error(a) / error(b));
-    };
-    pcout << std::fixed << std::setprecision(2)
-          << "final velocity rate: " << rate([](const RunSummary &r) { return r.final_errors.velocity_l2; })
-          << ", final pressure rate: " << rate([](const RunSummary &r) { return r.final_errors.pressure_l2; })
-          << std::defaultfloat << std::endl;
+    // Rate between the last two cycles (the asymptotic one), final time.
+    const auto &a = runs[runs.size() - 2].final_errors, &b = runs.back().final_errors;
+    const double velocity_rate = std::log2(a.velocity_l2 / b.velocity_l2);
+    const double pressure_rate = std::log2(a.pressure_l2 / b.pressure_l2);
+    pcout << std::fixed << std::setprecision(2) << "final velocity rate: " << velocity_rate;
+    if (with_pressure)
+      pcout << ", final pressure rate: " << pressure_rate;
+    pcout << std::defaultfloat << std::endl;
+    if (v.minimum_velocity_rate > 0)
+      pcout << "velocity rate >= " << v.minimum_velocity_rate << ": "
+            << (velocity_rate >= v.minimum_velocity_rate ? "yes" : "no") << std::endl;
+    if (v.minimum_pressure_rate > 0)
+      pcout << "pressure rate >= " << v.minimum_pressure_rate << ": "
+            << (with_pressure && pressure_rate >= v.minimum_pressure_rate ? "yes" : "no")
+            << std::endl;
   }
 
   template void run_study<2>(const Parameters::All &, MPI_Comm);

@@ -162,6 +162,13 @@ namespace Suspension::Fluid
     PETScWrappers::PreconditionBoomerAMG::AdditionalData data;
     data.symmetric_operator = true;
     data.strong_threshold   = dim == 2 ? 0.25 : 0.5;
+    // With small time steps A is dominated by the mass matrix: few strong
+    // connections, so coarsening stalls early and hypre's default direct
+    // solve on the (then large) coarsest level dominates the cost. Smooth
+    // there instead.
+    data.relaxation_type_coarse =
+      PETScWrappers::PreconditionBoomerAMG::AdditionalData::RelaxationType::symmetricSORJacobi;
+    data.n_sweeps_coarse = 2;
     amg_momentum->initialize(A, data);
   }
 

@@ -61,6 +61,37 @@ namespace Suspension::Fluid
     space.velocity_constraints.distribute(unit_response);
   }
 
+  namespace
+  {
+    /// Consecutive timer sections; no-op when no timer was given.
+    class Sections
+    {
+    public:
+      Sections(TimerOutput *timer, const char *name)
+        : timer(timer)
+      {
+        if (timer)
+          timer->enter_subsection(name);
+      }
+      void next(const char *name)
+      {
+        if (timer)
+          {
+            timer->leave_subsection();
+            timer->enter_subsection(name);
+          }
+      }
+      ~Sections()
+      {
+        if (timer)
+          timer->leave_subsection();
+      }
+
+    private:
+      TimerOutput *timer;
+    };
+  } // namespace
+
   template <int dim>
   StepReport
   ProjectionScheme<dim>::advance(const double dt,
@@ -85,6 +116,7 @@ namespace Suspension::Fluid
       }
 
     // Constant matrices change only with alpha / dt (and the mesh).
+    Sections section(timer, "fluid: matrices for new dt");
     const double old_alpha_over_dt = operators.momentum_alpha_over_dt;
     operators.set_momentum_coefficients(alpha / dt, nu);
     if (operators.momentum_alpha_over_dt != old_alpha_over_dt)
@@ -96,6 +128,7 @@ namespace Suspension::Fluid
 
     // Extrapolated velocity (convection), history (time derivative) and
     // pressure P# = P^n + (4 psi^n - psi^{n-1}) / 3.
+    section.next("fluid: momentum right-hand side");
     u_older = u_old;
     u_old   = u;
     {
@@ -120,6 +153,7 @@ namespace Suspension::Fluid
     scene.set_time(t_new);
     space.make_velocity_constraints(scene, false, step_constraints);
     assemble_momentum_rhs(dt, t_new, sources);
+    section.next("fluid: momentum solve");
     report.momentum_iterations =
       operators.solve_momentum(u, rhs_u, parameters.fluid_solver.solver_tolerance);
     step_constraints.distribute(u);
@@ -139,6 +173,7 @@ namespace Suspension::Fluid
       }
 
     // 3. projection: the increment psi
+    section.next("fluid: projection");
     operators.D.vmult(div_u_load, u);
     rhs_p = div_u_load;
     rhs_p *= -alpha / dt;
@@ -149,6 +184,7 @@ namespace Suspension::Fluid
     space.increment_constraints.distribute(psi);
 
     // 4. pressure update; Pi div u is also the divergence diagnostic
+    section.next("fluid: pressure update");
     report.mass_iterations =
       operators.solve_pressure_mass(div_u, div_u_load, parameters.fluid_solver.solver_tolerance);
     space.pressure_constraints.distribute(div_u);

@@ -61,6 +61,7 @@ namespace Suspension::Parameters
     std::vector<double> box_upper{1., 1., 1.};
     // base cells per direction; empty: cells of aspect ratio one
     std::vector<unsigned int> subdivisions;
+    bool                      subdivisions_given = false;
 
     static void declare(ParameterHandler &prm, unsigned int dim);
     void        parse(ParameterHandler &prm, unsigned int dim);
@@ -208,6 +209,9 @@ namespace Suspension::Parameters
     ReferenceData       reference_data = ReferenceData::none;
     unsigned int        refinement_cycles = 1;
     unsigned int        time_step_cycles  = 1;
+    double              tolerance         = 0.;
+    double              minimum_velocity_rate = 0.;
+    double              minimum_pressure_rate = 0.;
 
     static void declare(ParameterHandler &prm, unsigned int dim);
     void        parse(ParameterHandler &prm, unsigned int dim);

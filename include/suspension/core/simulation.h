@@ -22,6 +22,8 @@ namespace Suspension
   struct RunSummary
   {
     Postprocess::FlowErrors final_errors;
+    /// errors at the report times and at the end, in time order
+    std::vector<std::pair<double, Postprocess::FlowErrors>> errors;
     double                  smallest_cell = 0.;
     double                  time_step     = 0.;
     unsigned int            n_steps       = 0;
@@ -48,7 +50,8 @@ namespace Suspension
     void   write_probes();
     void   add_statistics_row(const Fluid::StepReport &r, const Fluid::FlowDiagnostics &d,
                               double dt, double wall_time);
-    void   report_errors(double time);
+    void   report_errors(double time, bool steady);
+    void   report_verdicts(bool steady);
     void   print_progress(double dt, const Fluid::FlowDiagnostics &d, double elapsed) const;
     void   write_tables() const;
 
@@ -66,6 +69,9 @@ namespace Suspension
     Postprocess::FlowVerification<dim>        verification;
     TableHandler                              statistics, probes;
     Postprocess::FlowErrors                   last_errors;
-    double                                    last_output_time = 0.;
+    std::vector<std::pair<double, Postprocess::FlowErrors>> error_history;
+    std::vector<std::string>                  last_probe_values;
+    double                                    last_output_time   = 0.;
+    double                                    last_driving_force = 0.;
   };
 } // namespace Suspension

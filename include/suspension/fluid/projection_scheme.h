@@ -6,6 +6,9 @@
 #include <suspension/fluid/fluid_space.h>
 #include <suspension/fluid/momentum_source.h>
 
+#include <deal.II/base/timer.h>
+
+#include <optional>
 #include <vector>
 
 namespace Suspension::Fluid
@@ -57,6 +60,9 @@ namespace Suspension::Fluid
                      const FluidSpace<dim> &space,
                      FluidOperators<dim>   &operators);
 
+    /// Optional: time the sub-steps in these sections.
+    void set_timer(TimerOutput &timer) { this->timer = &timer; }
+
     /// Allocates the time levels and sets u^0 from the scene, P^0 = 0.
     void initialize();
 
@@ -86,6 +92,7 @@ namespace Suspension::Fluid
     const FluidSpace<dim> &space;
     FluidOperators<dim>   &operators;
     const double           nu;
+    TimerOutput           *timer = nullptr;
 
     AffineConstraints<double> step_constraints; // with boundary data at t^{n+1}
 
