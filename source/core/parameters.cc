@@ -423,10 +423,26 @@ namespace Suspension::Parameters
   }
 
   // ------------------------------------------------------------- FluidSolver
-  void FluidSolver::declare(ParameterHandler &prm)
+  void FluidSolver::declare(ParameterHandler &prm, const unsigned int dim)
   {
     const FluidSolver d;
     prm.enter_subsection("Fluid solver");
+    prm.declare_entry("Velocity",
+                      "navier-stokes",
+                      Patterns::Selection("navier-stokes|prescribed"),
+                      "navier-stokes: solve for velocity and pressure; "
+                      "prescribed: the velocity is 'Prescribed velocity' "
+                      "(interpolated into the velocity space) and no "
+                      "Navier-Stokes matrix is built.");
+    prm.declare_entry("Function constants",
+                      "",
+                      Patterns::Anything(),
+                      "Constants for 'Prescribed velocity', name=value pairs.");
+    prm.declare_entry("Prescribed velocity",
+                      zero_vector(dim),
+                      Patterns::Anything(),
+                      "Velocity for Velocity = prescribed: one expression of "
+                      "x, y[, z], t per component separated by ';'.");
     prm.declare_entry("Velocity degree",
                       std::to_string(d.velocity_degree),
                       Patterns::Integer(2, 4),
@@ -456,9 +472,12 @@ namespace Suspension::Parameters
     prm.leave_subsection();
   }
 
-  void FluidSolver::parse(ParameterHandler &prm)
+  void FluidSolver::parse(ParameterHandler &prm, const unsigned int dim)
   {
     prm.enter_subsection("Fluid solver");
+    mode = prm.get("Velocity") == "prescribed" ? VelocityMode::prescribed :
+                                                 VelocityMode::navier_stokes;
+    prescribed_velocity = {prm.get("Prescribed velocity"), prm.get("Function constants")};
     velocity_degree  = prm.get_integer("Velocity degree");
     pressure_degree  = prm.get_integer("Pressure degree");
     projection       = prm.get("Projection form") == "rotational" ?
@@ -469,10 +488,107 @@ namespace Suspension::Parameters
                          ConvectionForm::skew_symmetric;
     solver_tolerance = prm.get_double("Linear solver tolerance");
     prm.leave_subsection();
+    if (mode == VelocityMode::prescribed)
+      check_expression("Fluid solver/Prescribed velocity", prescribed_velocity, dim, dim);
     if (pressure_degree >= velocity_degree)
       throw InputError("Fluid solver/Pressure degree",
                        "must be lower than the velocity degree (" +
                          std::to_string(velocity_degree) + ")");
+  }
+
+  // ------------------------------------------------------------------- Solid
+  void Solid::declare(ParameterHandler &prm, const unsigned int dim)
+  {
+    const Solid d;
+    prm.enter_subsection("Solid");
+    prm.declare_entry("Initial fraction",
+                      "none",
+                      Patterns::Selection("none|particles|function"),
+                      "Initial solid volume fraction phi: none (no solid, "
+                      "no phi or B is allocated), particles (the list in "
+                      "'Particles' with a smoothed edge), or function.");
+    prm.declare_entry("Particles",
+                      "",
+                      Patterns::Anything(),
+                      std::string("Particles as centre and radius, ") +
+                        (dim == 2 ? "'x, y, r'" : "'x, y, z, r'") +
+                        ", separated by ';' (circles in 2D, spheres in 3D).");
+    prm.declare_entry("Interface width",
+                      std::to_string(d.interface_width),
+                      Patterns::Double(0., 20.),
+                      "Width of the smoothed particle edge in cells of the "
+                      "finest level: phi = (1 - tanh(2 (|x - c| - r) / "
+                      "(width h))) / 2.");
+    prm.declare_entry("Function constants",
+                      "",
+                      Patterns::Anything(),
+                      "Constants for 'Fraction expression'.");
+    prm.declare_entry("Fraction expression",
+                      "0",
+                      Patterns::Anything(),
+                      "Initial phi for Initial fraction = function, an "
+                      "expression of x, y[, z].");
+    prm.declare_entry("Shear modulus",
+                      "0",
+                      Patterns::Double(0.),
+                      "G of the neo-Hookean solid: stress G phi (B - I). 0: "
+                      "phi is a passive tracer and no B is allocated.");
+    prm.declare_entry("Degree",
+                      std::to_string(d.degree),
+                      Patterns::Integer(0, 4),
+                      "Polynomial degree of the discontinuous (FE_DGQ) "
+                      "phi and B.");
+    prm.declare_entry("Limiter",
+                      "true",
+                      Patterns::Bool(),
+                      "Bound-preserving scaling limiter (Zhang & Shu 2010) "
+                      "keeping 0 <= phi <= 1 at the nodes and quadrature "
+                      "points of every cell, cell averages unchanged.");
+    prm.declare_entry("Transport CFL",
+                      std::to_string(d.transport_cfl),
+                      Patterns::Double(1e-3, 1.),
+                      "Sub-step limit of the explicit SSP-RK3 transport: "
+                      "dt |u| (2k+1) / h at most this.");
+    prm.declare_entry("Elastic number",
+                      std::to_string(d.elastic_number),
+                      Patterns::Double(1e-3, 100.),
+                      "Time-step limit dt sqrt(G / rho) / h of the explicit "
+                      "elastic coupling (elastic wave crossing a cell).");
+    prm.leave_subsection();
+  }
+
+  void Solid::parse(ParameterHandler &prm, const unsigned int dim)
+  {
+    prm.enter_subsection("Solid");
+    const std::string t = prm.get("Initial fraction");
+    initial_fraction = t == "none"      ? InitialFraction::none :
+                       t == "particles" ? InitialFraction::particles :
+                                          InitialFraction::function;
+    interface_width     = prm.get_double("Interface width");
+    constants           = prm.get("Function constants");
+    fraction_expression = prm.get("Fraction expression");
+    shear_modulus       = prm.get_double("Shear modulus");
+    degree              = prm.get_integer("Degree");
+    limiter             = prm.get_bool("Limiter");
+    transport_cfl       = prm.get_double("Transport CFL");
+    elastic_number      = prm.get_double("Elastic number");
+    const std::string list = prm.get("Particles");
+    prm.leave_subsection();
+    particles.clear();
+    for (const auto &p : split(list, ';'))
+      {
+        particles.push_back(to_doubles("Solid/Particles", p));
+        if (particles.back().size() != dim + 1)
+          throw InputError("Solid/Particles",
+                           "particle '" + p + "' needs " + std::to_string(dim) +
+                             " coordinates and a radius");
+        if (particles.back().back() <= 0)
+          throw InputError("Solid/Particles", "radius of '" + p + "' is not positive");
+      }
+    if (initial_fraction == InitialFraction::particles && particles.empty())
+      throw InputError("Solid/Particles", "Initial fraction = particles needs particles");
+    if (initial_fraction == InitialFraction::function)
+      check_expression("Solid/Fraction expression", {fraction_expression, constants}, 1, dim);
   }
 
   // ------------------------------------------------------------ TimeStepping
@@ -614,6 +730,12 @@ namespace Suspension::Parameters
                       Patterns::Anything(),
                       "Exact velocity, one expression of x, y[, z], t per "
                       "component separated by ';'.");
+    prm.declare_entry("Exact solid fraction",
+                      "",
+                      Patterns::Anything(),
+                      "If set, the final phi is compared with this "
+                      "expression of x, y[, z] (L1 error), e.g. the initial "
+                      "shape after a full revolution.");
     prm.declare_entry("Exact pressure",
                       "0",
                       Patterns::Anything(),
@@ -669,6 +791,7 @@ namespace Suspension::Parameters
                                        ExactSolutionType::channel_startup;
     exact_velocity = {prm.get("Exact velocity"), prm.get("Function constants")};
     exact_pressure = prm.get("Exact pressure");
+    exact_fraction = Utilities::trim(prm.get("Exact solid fraction"));
     report_times   = to_doubles("Verification/Report times",
                               prm.get("Report times"));
     reference_data = prm.get("Reference data") == "none" ?
@@ -688,6 +811,9 @@ namespace Suspension::Parameters
                          1,
                          dim);
       }
+    if (!exact_fraction.empty())
+      check_expression("Verification/Exact solid fraction",
+                       {exact_fraction, exact_velocity.constants}, 1, dim);
     if (refinement_cycles > 1 && time_step_cycles > 1)
       throw InputError("Verification/Time step cycles",
                        "a study refines either the mesh or the time step, "
@@ -707,7 +833,8 @@ namespace Suspension::Parameters
     FlowDriving::declare(prm, dim);
     Material::declare(prm);
     InitialConditions::declare(prm, dim);
-    FluidSolver::declare(prm);
+    FluidSolver::declare(prm, dim);
+    Solid::declare(prm, dim);
     TimeStepping::declare(prm);
     Output::declare(prm);
     Verification::declare(prm, dim);
@@ -722,7 +849,8 @@ namespace Suspension::Parameters
     flow_driving.parse(prm, dim);
     material.parse(prm);
     initial_conditions.parse(prm, dim);
-    fluid_solver.parse(prm);
+    fluid_solver.parse(prm, dim);
+    solid.parse(prm, dim);
     time_stepping.parse(prm);
     output.parse(prm, dim);
     verification.parse(prm, dim);

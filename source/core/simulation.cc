@@ -318,8 +318,11 @@ namespace Suspension
     write_tables();
 
     pcout << "  final state: kinetic energy " << std::scientific << std::setprecision(6)
-          << diagnostics.kinetic_energy << ", bulk velocity " << diagnostics.bulk_velocity
-          << ", -dp/dx " << last_driving_force << std::defaultfloat << std::endl;
+          << diagnostics.kinetic_energy;
+    if (parameters.flow_driving.type != Parameters::FlowDrivingType::none)
+      pcout << ", bulk velocity " << diagnostics.bulk_velocity << ", -dp/dx "
+            << last_driving_force;
+    pcout << std::defaultfloat << std::endl;
     for (const auto &line : last_probe_values)
       pcout << line << std::endl;
     report_errors(fluid.time(), steady);

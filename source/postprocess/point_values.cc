@@ -2,16 +2,18 @@
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/fe/mapping_q1.h>
 
+#include <deal.II/lac/la_parallel_vector.h>
+
 #include <suspension/postprocess/point_values.h>
 
 #include <limits>
 
 namespace Suspension::Postprocess
 {
-  template <int dim>
+  template <int dim, typename VectorType>
   std::vector<Vector<double>>
   point_values(const DoFHandler<dim>         &dof_handler,
-               const Fluid::VectorType       &vector,
+               const VectorType              &vector,
                const std::vector<Point<dim>> &points)
   {
     const auto        &fe  = dof_handler.get_fe();
@@ -63,7 +65,13 @@ namespace Suspension::Postprocess
   }
 
   template std::vector<Vector<double>>
-  point_values<2>(const DoFHandler<2> &, const Fluid::VectorType &, const std::vector<Point<2>> &);
+  point_values(const DoFHandler<2> &, const Fluid::VectorType &, const std::vector<Point<2>> &);
   template std::vector<Vector<double>>
-  point_values<3>(const DoFHandler<3> &, const Fluid::VectorType &, const std::vector<Point<3>> &);
+  point_values(const DoFHandler<3> &, const Fluid::VectorType &, const std::vector<Point<3>> &);
+  template std::vector<Vector<double>>
+  point_values(const DoFHandler<2> &, const LinearAlgebra::distributed::Vector<double> &,
+               const std::vector<Point<2>> &);
+  template std::vector<Vector<double>>
+  point_values(const DoFHandler<3> &, const LinearAlgebra::distributed::Vector<double> &,
+               const std::vector<Point<3>> &);
 } // namespace Suspension::Postprocess

@@ -146,16 +146,52 @@ namespace Suspension::Parameters
     none
   };
 
+  enum class VelocityMode
+  {
+    navier_stokes,
+    prescribed
+  };
+
   struct FluidSolver
   {
+    VelocityMode       mode = VelocityMode::navier_stokes;
+    FunctionExpression prescribed_velocity{"", ""};
     unsigned int   velocity_degree = 2;
     unsigned int   pressure_degree = 1;
     ProjectionForm projection      = ProjectionForm::rotational;
     ConvectionForm convection      = ConvectionForm::skew_symmetric;
     double         solver_tolerance = 1e-10;
 
-    static void declare(ParameterHandler &prm);
-    void        parse(ParameterHandler &prm);
+    static void declare(ParameterHandler &prm, unsigned int dim);
+    void        parse(ParameterHandler &prm, unsigned int dim);
+  };
+
+  enum class InitialFraction
+  {
+    none,
+    particles,
+    function
+  };
+
+  /// The solid phase: initial fraction, elasticity, DG transport.
+  struct Solid
+  {
+    InitialFraction                  initial_fraction = InitialFraction::none;
+    std::vector<std::vector<double>> particles; // centre..., radius
+    double                           interface_width = 1.5; // in cells
+    std::string                      fraction_expression;
+    std::string                      constants;
+    double                           shear_modulus = 0.;
+    unsigned int                     degree        = 1;
+    bool                             limiter       = true;
+    double                           transport_cfl = 0.2;
+    double                           elastic_number = 0.5;
+
+    bool enabled() const { return initial_fraction != InitialFraction::none; }
+    bool elastic() const { return enabled() && shear_modulus > 0.; }
+
+    static void declare(ParameterHandler &prm, unsigned int dim);
+    void        parse(ParameterHandler &prm, unsigned int dim);
   };
 
   struct TimeStepping
@@ -203,6 +239,7 @@ namespace Suspension::Parameters
   struct Verification
   {
     ExactSolutionType   exact_solution = ExactSolutionType::none;
+    std::string         exact_fraction; // compared in L1 at the end
     FunctionExpression  exact_velocity{"", ""};
     std::string         exact_pressure;
     std::vector<double> report_times;
@@ -229,6 +266,7 @@ namespace Suspension::Parameters
     Material           material;
     InitialConditions  initial_conditions;
     FluidSolver        fluid_solver;
+    Solid              solid;
     TimeStepping       time_stepping;
     Output             output;
     Verification       verification;

@@ -18,9 +18,9 @@ namespace Suspension::Postprocess
    * the results are summed over ranks (averaged where a point lies on a
    * boundary between ranks). Points outside the domain give NaN.
    */
-  template <int dim>
+  template <int dim, typename VectorType>
   std::vector<Vector<double>>
   point_values(const DoFHandler<dim>         &dof_handler,
-               const Fluid::VectorType       &ghosted_vector,
+               const VectorType              &vector,
                const std::vector<Point<dim>> &points);
 } // namespace Suspension::Postprocess

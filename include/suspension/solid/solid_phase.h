@@ -1,0 +1,108 @@
+#pragma once
+
+#include <deal.II/base/function.h>
+#include <deal.II/distributed/tria.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_system.h>
+
+#include <suspension/core/parameters.h>
+#include <suspension/fluid/fluid_operators.h>
+#include <suspension/fluid/fluid_space.h>
+#include <suspension/fluid/momentum_source.h>
+#include <suspension/solid/transport_operator.h>
+
+#include <memory>
+
+namespace Suspension::Solid
+{
+  /// Bounds and integrals of the solid fields after a step.
+  struct SolidDiagnostics
+  {
+    double       volume = 0., volume_drift = 0.; // integral of phi, relative change
+    double       min_phi = 0., max_phi = 0.;
+    unsigned int limited_cells = 0, out_of_bound_means = 0, substeps = 0;
+    double       min_det_B = 1., min_eigenvalue_B = 1.;
+  };
+
+  /// Shape of one particle from the moments of phi.
+  template <int dim>
+  struct ParticleShape
+  {
+    Point<dim>     centroid;
+    Tensor<1, dim> velocity;
+    double         taylor_deformation = 0.; // (L - S) / (L + S)
+    double         inclination        = 0.; // degrees, long axis against x
+    double         solid_area         = 0.; // measure of {phi >= 1/2}
+  };
+
+  /**
+   * The solid phase of the one-continuum model: the volume fraction phi
+   * and, for an elastic solid (G > 0), the left Cauchy-Green tensor B, in
+   * one discontinuous FE_DGQ(k) field on the fluid's mesh. advance()
+   * carries them with a given velocity by SSP-RK3 (Shu & Osher 1988),
+   * sub-stepped to the transport CFL, with the bound-preserving limiter
+   * after every stage. As a MomentumSource it adds the neo-Hookean stress
+   * G phi (B - I) to the fluid.
+   *
+   * Limits: the velocity is interpolated linearly in time between the two
+   * fields handed to advance(); B is only checked (SPD), not limited.
+   */
+  template <int dim>
+  class SolidPhase : public Fluid::MomentumSource<dim>
+  {
+  public:
+    static constexpr unsigned int n_B = dim * (dim + 1) / 2;
+
+    SolidPhase(const Parameters::All &parameters,
+               const parallel::distributed::Triangulation<dim> &tria);
+
+    /// DoFs, operator and initial fields (phi from the scene, B = I).
+    void setup(const Fluid::FluidSpace<dim> &fluid_space);
+
+    /// Largest sub-step of the transport for a velocity with
+    /// max |u| k_u / h = speed_over_h.
+    double max_substep(double speed_over_h) const;
+
+    /// Advances phi (and B) by dt with the velocity going linearly from
+    /// u_begin to u_end (PETSc vectors on the fluid's velocity space).
+    SolidDiagnostics advance(double dt, double speed_over_h,
+                             const Fluid::VectorType &u_begin,
+                             const Fluid::VectorType &u_end);
+
+    SolidDiagnostics diagnostics() const;
+
+    /// Moments of phi (one particle), with the velocity for its centroid.
+    ParticleShape<dim> particle_shape(const Fluid::FluidSpace<dim> &space,
+                                      const Fluid::VectorType      &velocity) const;
+
+    /// L1 norm of phi - exact.
+    double l1_error(const Function<dim> &exact) const;
+
+    /// Values of all components at points (phi, then B in unrolled order).
+    std::vector<Vector<double>> values_at(const std::vector<Point<dim>> &points) const;
+
+    // MomentumSource
+    void add(const typename Triangulation<dim>::active_cell_iterator &cell,
+             const std::vector<Point<dim>> &points,
+             const std::vector<Point<dim>> &unit_points,
+             double                          time,
+             std::vector<Tensor<1, dim>>          &force,
+             std::vector<SymmetricTensor<2, dim>> &stress) const override;
+
+    const DoFHandler<dim> &get_dof_handler() const { return dof_handler; }
+    const VectorType      &get_solution() const { return solution; }
+    std::vector<std::string> component_names() const;
+
+  private:
+    void check_B(const SolidDiagnostics &d, double time) const;
+    void copy_velocity(const Fluid::VectorType &in, VectorType &out) const;
+
+    const Parameters::All &parameters;
+    FESystem<dim>          fe;
+    DoFHandler<dim>        dof_handler;
+    TransportOperator<dim> transport;
+    VectorType             solution, stage, stage_rhs, u0, u1, u_stage;
+    double                 initial_volume = 0., time = 0.;
+    mutable std::unique_ptr<FEValues<dim>> stress_values;
+  };
+} // namespace Suspension::Solid

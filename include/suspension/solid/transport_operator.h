@@ -1,0 +1,67 @@
+#pragma once
+
+#include <deal.II/base/quadrature_lib.h>
+#include <deal.II/dofs/dof_handler.h>
+#include <deal.II/lac/affine_constraints.h>
+#include <deal.II/lac/la_parallel_vector.h>
+#include <deal.II/matrix_free/matrix_free.h>
+
+namespace Suspension::Solid
+{
+  using namespace dealii;
+  using VectorType = LinearAlgebra::distributed::Vector<double>;
+
+  /// Smallest and largest values seen by the limiter, and its work.
+  struct LimiterReport
+  {
+    unsigned int limited_cells      = 0; // cells scaled towards their mean
+    unsigned int out_of_bound_means = 0; // cell means outside [0, 1]
+    double       min_phi = 1., max_phi = 0.;
+  };
+
+  /**
+   * The discontinuous Galerkin operator of the solid fields, matrix-free
+   * (MatrixFree handles interior, periodic and hanging-node faces alike):
+   *
+   *   d phi / dt = - div(u phi),
+   *   d B / dt   = - div(u B) + (div u) B + (grad u) B + B (grad u)^T,
+   *
+   * i.e. the conservative form of the transport of phi and the
+   * upper-convected derivative of B written so that, for the continuous
+   * (not pointwise divergence-free) velocity, it still equals
+   * dB/dt + u.grad B - (grad u) B - B (grad u)^T = 0. Upwind fluxes; on
+   * inflow boundaries fluid enters (phi = 0, B = I). apply() returns
+   * M^{-1} R(y): the right-hand side of the semi-discrete system, with the
+   * exact cell-wise inverse mass matrix of FE_DGQ.
+   *
+   * Component 0 of the solid DoFHandler is phi, components 1..n_B the
+   * independent entries of B in SymmetricTensor's unrolled order.
+   */
+  template <int dim>
+  class TransportOperator
+  {
+  public:
+    static constexpr unsigned int n_B = dim * (dim + 1) / 2;
+
+    void reinit(const DoFHandler<dim>           &dof_solid,
+                const DoFHandler<dim>           &dof_velocity,
+                const AffineConstraints<double> &velocity_constraints,
+                bool                             with_B);
+
+    void initialize_solid_vector(VectorType &v) const;
+    void initialize_velocity_vector(VectorType &v) const;
+
+    /// dst = M^{-1} R(src; u), u a ghosted velocity vector.
+    void apply(const VectorType &src, VectorType &dst, const VectorType &velocity) const;
+
+    /// Zhang-Shu scaling of phi towards each cell mean so that 0 <= phi <= 1
+    /// at the nodes and quadrature points; means are left unchanged.
+    LimiterReport limit(VectorType &solution, bool scale) const;
+
+    const MatrixFree<dim, double> &get_matrix_free() const { return matrix_free; }
+
+  private:
+    MatrixFree<dim, double> matrix_free;
+    bool                    with_B = false;
+  };
+} // namespace Suspension::Solid

@@ -1,0 +1,396 @@
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/symmetric_tensor.h>
+#include <deal.II/dofs/dof_tools.h>
+#include <deal.II/fe/fe_dgq.h>
+#include <deal.II/fe/fe_values.h>
+#include <deal.II/lac/read_write_vector.h>
+#include <deal.II/numerics/vector_tools.h>
+
+#include <suspension/core/scene.h>
+#include <suspension/postprocess/point_values.h>
+#include <suspension/solid/solid_phase.h>
+
+#include <cmath>
+#include <sstream>
+
+namespace Suspension::Solid
+{
+  namespace
+  {
+    /// phi from the particle list (smoothed edges, periodic images) or an
+    /// expression; B = I.
+    template <int dim>
+    class InitialSolid : public Function<dim>
+    {
+    public:
+      InitialSolid(const Parameters::All &p, const unsigned int n_components, const double h)
+        : Function<dim>(n_components)
+        , solid(p.solid)
+        , width(p.solid.interface_width * h)
+      {
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            period[d] = p.boundary_conditions.type[2 * d] == Parameters::BoundaryType::periodic ?
+                          p.geometry.box_upper[d] - p.geometry.box_lower[d] :
+                          0.;
+          }
+        if (solid.initial_fraction == Parameters::InitialFraction::function)
+          expression = make_function<dim>({solid.fraction_expression, solid.constants}, 1);
+      }
+
+      double value(const Point<dim> &x, const unsigned int c) const override
+      {
+        if (c > 0)
+          return c <= dim ? 1. : 0.; // B = I, diagonal first
+        if (expression)
+          return expression->value(x);
+        double phi = 0.;
+        for (const auto &particle : solid.particles)
+          {
+            double r2 = 0.;
+            for (unsigned int d = 0; d < dim; ++d)
+              {
+                double dx = x[d] - particle[d];
+                if (period[d] > 0)
+                  dx -= period[d] * std::round(dx / period[d]);
+                r2 += dx * dx;
+              }
+            const double distance = std::sqrt(r2) - particle[dim];
+            phi = std::max(phi, width > 0 ? 0.5 * (1. - std::tanh(2. * distance / width)) :
+                                            (distance <= 0 ? 1. : 0.));
+          }
+        return phi;
+      }
+
+    private:
+      const Parameters::Solid       &solid;
+      const double                   width;
+      std::array<double, dim>        period{};
+      std::unique_ptr<Function<dim>> expression;
+    };
+
+    template <int dim>
+    FESystem<dim> make_fe(const Parameters::Solid &solid)
+    {
+      const unsigned int n_B = dim * (dim + 1) / 2;
+      return FESystem<dim>(FE_DGQ<dim>(solid.degree), solid.elastic() ? 1 + n_B : 1);
+    }
+  } // namespace
+
+  template <int dim>
+  SolidPhase<dim>::SolidPhase(const Parameters::All                           &parameters,
+                              const parallel::distributed::Triangulation<dim> &tria)
+    : parameters(parameters)
+    , fe(make_fe<dim>(parameters.solid))
+    , dof_handler(tria)
+  {}
+
+  template <int dim>
+  std::vector<std::string> SolidPhase<dim>::component_names() const
+  {
+    std::vector<std::string> names = {"phi"};
+    if (fe.n_components() > 1)
+      for (unsigned int c = 0; c < n_B; ++c)
+        {
+          const auto ij = SymmetricTensor<2, dim>::unrolled_to_component_indices(c);
+          names.push_back("B_" + std::to_string(ij[0] + 1) + std::to_string(ij[1] + 1));
+        }
+    return names;
+  }
+
+  template <int dim>
+  void SolidPhase<dim>::setup(const Fluid::FluidSpace<dim> &fluid_space)
+  {
+    dof_handler.distribute_dofs(fe);
+    // hanging nodes and periodicity of the velocity only (its Dirichlet
+    // values are read as they are)
+    AffineConstraints<double> velocity_constraints;
+    velocity_constraints.reinit(fluid_space.relevant_velocity);
+    DoFTools::make_hanging_node_constraints(fluid_space.dof_velocity, velocity_constraints);
+    velocity_constraints.close();
+    transport.reinit(dof_handler, fluid_space.dof_velocity, velocity_constraints,
+                     parameters.solid.elastic());
+    transport.initialize_solid_vector(solution);
+    transport.initialize_solid_vector(stage);
+    transport.initialize_solid_vector(stage_rhs);
+    transport.initialize_velocity_vector(u0);
+    transport.initialize_velocity_vector(u1);
+    transport.initialize_velocity_vector(u_stage);
+
+    double h = std::numeric_limits<double>::max();
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        h = std::min(h, cell->minimum_vertex_distance());
+    h = Utilities::MPI::min(h, dof_handler.get_communicator());
+    VectorTools::interpolate(dof_handler, InitialSolid<dim>(parameters, fe.n_components(), h),
+                             solution);
+    if (parameters.solid.limiter)
+      transport.limit(solution, true);
+    initial_volume = diagnostics().volume;
+    time           = 0.;
+  }
+
+  template <int dim>
+  double SolidPhase<dim>::max_substep(const double speed_over_h) const
+  {
+    // speed_over_h = max |u| k_u / h; the DG limit is dt |u| (2k+1) / h <= C
+    const double k_u = parameters.fluid_solver.velocity_degree;
+    const double k   = parameters.solid.degree;
+    if (speed_over_h <= 0.)
+      return std::numeric_limits<double>::max();
+    return parameters.solid.transport_cfl / ((2. * k + 1.) * speed_over_h / k_u);
+  }
+
+  template <int dim>
+  void SolidPhase<dim>::copy_velocity(const Fluid::VectorType &in, VectorType &out) const
+  {
+    LinearAlgebra::ReadWriteVector<double> values(out.locally_owned_elements());
+    values.import(in, VectorOperation::insert);
+    out.zero_out_ghost_values();
+    out.import(values, VectorOperation::insert);
+  }
+
+  template <int dim>
+  SolidDiagnostics SolidPhase<dim>::advance(const double dt, const double speed_over_h,
+                                            const Fluid::VectorType &u_begin,
+                                            const Fluid::VectorType &u_end)
+  {
+    copy_velocity(u_begin, u0);
+    copy_velocity(u_end, u1);
+    const unsigned int n_sub = std::max(1., std::ceil(dt / max_substep(speed_over_h) - 1e-12));
+    const double       h     = dt / n_sub;
+    const bool         scale = parameters.solid.limiter;
+
+    const auto velocity_at = [&](const double fraction) {
+      u_stage.zero_out_ghost_values();
+      u_stage.equ(1. - fraction, u0);
+      u_stage.add(fraction, u1);
+      u_stage.update_ghost_values();
+    };
+    LimiterReport report, r;
+    const auto    limit = [&](VectorType &v) {
+      v.zero_out_ghost_values();
+      r = transport.limit(v, scale);
+      report.limited_cells += r.limited_cells;
+      report.out_of_bound_means += r.out_of_bound_means;
+    };
+
+    for (unsigned int s = 0; s < n_sub; ++s)
+      {
+        const double f = s * h / dt;
+        // SSP-RK3: stages at t, t + h, t + h/2
+        velocity_at(f);
+        solution.zero_out_ghost_values();
+        transport.apply(solution, stage_rhs, u_stage);
+        stage.equ(1., solution);
+        stage.add(h, stage_rhs);
+        limit(stage);
+
+        velocity_at(f + h / dt);
+        transport.apply(stage, stage_rhs, u_stage);
+        stage.add(h, stage_rhs);
+        stage.sadd(0.25, 0.75, solution);
+        limit(stage);
+
+        velocity_at(f + 0.5 * h / dt);
+        transport.apply(stage, stage_rhs, u_stage);
+        stage.add(h, stage_rhs);
+        solution.sadd(1. / 3., 2. / 3., stage);
+        limit(solution);
+      }
+    time += dt;
+
+    SolidDiagnostics d     = diagnostics();
+    d.limited_cells        = Utilities::MPI::sum(report.limited_cells, dof_handler.get_communicator());
+    d.out_of_bound_means   = Utilities::MPI::sum(report.out_of_bound_means, dof_handler.get_communicator());
+    d.substeps             = n_sub;
+    check_B(d, time);
+    return d;
+  }
+
+  template <int dim>
+  SolidDiagnostics SolidPhase<dim>::diagnostics() const
+  {
+    SolidDiagnostics d;
+    const QGauss<dim>  quadrature(fe.degree + 2);
+    FEValues<dim>      fe_values(fe, quadrature, update_values | update_JxW_values);
+    const unsigned int nc = fe.n_components();
+    std::vector<Vector<double>> values(quadrature.size(), Vector<double>(nc));
+    double volume = 0., lo = 1e300, hi = -1e300, det_min = 1e300, eig_min = 1e300;
+    std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          fe_values.get_function_values(solution, values);
+          for (const unsigned int q : fe_values.quadrature_point_indices())
+            {
+              volume += values[q][0] * fe_values.JxW(q);
+              lo = std::min(lo, values[q][0]);
+              hi = std::max(hi, values[q][0]);
+              if (nc > 1)
+                {
+                  SymmetricTensor<2, dim> B;
+                  for (unsigned int c = 0; c < n_B; ++c)
+                    B[SymmetricTensor<2, dim>::unrolled_to_component_indices(c)] = values[q][1 + c];
+                  det_min = std::min(det_min, determinant(B));
+                  eig_min = std::min(eig_min, eigenvalues(B)[dim - 1]);
+                }
+            }
+          // nodal values too: the limiter's bounds hold there as well
+          cell->get_dof_indices(dofs);
+          for (unsigned int i = 0; i < dofs.size(); ++i)
+            if (fe.system_to_component_index(i).first == 0)
+              {
+                lo = std::min(lo, solution(dofs[i]));
+                hi = std::max(hi, solution(dofs[i]));
+              }
+        }
+    const MPI_Comm comm = dof_handler.get_communicator();
+    d.volume       = Utilities::MPI::sum(volume, comm);
+    d.volume_drift = initial_volume > 0 ? (d.volume - initial_volume) / initial_volume : 0.;
+    d.min_phi      = Utilities::MPI::min(lo, comm);
+    d.max_phi      = Utilities::MPI::max(hi, comm);
+    if (nc > 1)
+      {
+        d.min_det_B        = Utilities::MPI::min(det_min, comm);
+        d.min_eigenvalue_B = Utilities::MPI::min(eig_min, comm);
+      }
+    return d;
+  }
+
+  template <int dim>
+  void SolidPhase<dim>::check_B(const SolidDiagnostics &d, const double t) const
+  {
+    if (fe.n_components() == 1)
+      return;
+    if (!(d.min_eigenvalue_B > 0.) || !std::isfinite(d.volume))
+      {
+        std::ostringstream message;
+        message << "the left Cauchy-Green tensor B is no longer symmetric positive definite at t = "
+                << t << " (smallest eigenvalue " << d.min_eigenvalue_B
+                << "); reduce the time step ('Solid/Elastic number', 'Time stepping/CFL number')";
+        throw std::runtime_error(message.str());
+      }
+  }
+
+  template <int dim>
+  ParticleShape<dim> SolidPhase<dim>::particle_shape(const Fluid::FluidSpace<dim> &space,
+                                                     const Fluid::VectorType      &velocity) const
+  {
+    const QGauss<dim> quadrature(fe.degree + 2);
+    FEValues<dim>     fe_values(fe, quadrature,
+                            update_values | update_JxW_values | update_quadrature_points);
+    FEValues<dim>     fe_u(space.fe_velocity, quadrature, update_values);
+    const FEValuesExtractors::Scalar phi_x(0);
+    const FEValuesExtractors::Vector velocities(0);
+    std::vector<double>         phi(quadrature.size());
+    std::vector<Tensor<1, dim>> u(quadrature.size());
+    // moments: V, V x, V u, V x x^T (unrolled), area(phi >= 1/2)
+    std::vector<double> m(2 + 2 * dim + dim * dim, 0.);
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          fe_u.reinit(Fluid::FluidSpace<dim>::cell_of(cell, space.dof_velocity));
+          fe_values[phi_x].get_function_values(solution, phi);
+          fe_u[velocities].get_function_values(velocity, u);
+          for (const unsigned int q : fe_values.quadrature_point_indices())
+            {
+              const double w = phi[q] * fe_values.JxW(q);
+              const auto  &x = fe_values.quadrature_point(q);
+              m[0] += w;
+              m[1] += (phi[q] >= 0.5 ? fe_values.JxW(q) : 0.);
+              for (unsigned int d = 0; d < dim; ++d)
+                {
+                  m[2 + d] += w * x[d];
+                  m[2 + dim + d] += w * u[q][d];
+                  for (unsigned int e = 0; e < dim; ++e)
+                    m[2 + 2 * dim + d * dim + e] += w * x[d] * x[e];
+                }
+            }
+        }
+    Utilities::MPI::sum(m, dof_handler.get_communicator(), m);
+    ParticleShape<dim> s;
+    s.solid_area = m[1];
+    if (m[0] <= 0.)
+      return s;
+    SymmetricTensor<2, dim> moment;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        s.centroid[d] = m[2 + d] / m[0];
+        s.velocity[d] = m[2 + dim + d] / m[0];
+      }
+    for (unsigned int d = 0; d < dim; ++d)
+      for (unsigned int e = d; e < dim; ++e)
+        moment[d][e] = m[2 + 2 * dim + d * dim + e] / m[0] - s.centroid[d] * s.centroid[e];
+    // Equivalent ellipse (ellipsoid): second moments a^2/4 (a^2/5) of its
+    // semi-axes a.
+    const auto   eig    = eigenvectors(moment);
+    const double factor = dim == 2 ? 4. : 5.;
+    const double L      = std::sqrt(factor * std::max(0., eig.front().first));
+    const double S      = std::sqrt(factor * std::max(0., eig.back().first));
+    s.taylor_deformation = L + S > 0 ? (L - S) / (L + S) : 0.;
+    double angle = std::atan2(eig.front().second[1], eig.front().second[0]) * 180. / numbers::PI;
+    if (angle > 90.)
+      angle -= 180.;
+    if (angle <= -90.)
+      angle += 180.;
+    s.inclination = angle;
+    return s;
+  }
+
+  template <int dim>
+  double SolidPhase<dim>::l1_error(const Function<dim> &exact) const
+  {
+    const QGauss<dim> quadrature(fe.degree + 3);
+    FEValues<dim>     fe_values(fe, quadrature,
+                            update_values | update_JxW_values | update_quadrature_points);
+    const FEValuesExtractors::Scalar phi_x(0);
+    std::vector<double>              phi(quadrature.size());
+    double                           error = 0.;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          fe_values[phi_x].get_function_values(solution, phi);
+          for (const unsigned int q : fe_values.quadrature_point_indices())
+            error += std::abs(phi[q] - exact.value(fe_values.quadrature_point(q))) * fe_values.JxW(q);
+        }
+    return Utilities::MPI::sum(error, dof_handler.get_communicator());
+  }
+
+  template <int dim>
+  std::vector<Vector<double>>
+  SolidPhase<dim>::values_at(const std::vector<Point<dim>> &points) const
+  {
+    return Postprocess::point_values(dof_handler, solution, points);
+  }
+
+  template <int dim>
+  void SolidPhase<dim>::add(const typename Triangulation<dim>::active_cell_iterator &cell,
+                            const std::vector<Point<dim>> &,
+                            const std::vector<Point<dim>> &unit_points,
+                            const double,
+                            std::vector<Tensor<1, dim>> &,
+                            std::vector<SymmetricTensor<2, dim>> &stress) const
+  {
+    if (fe.n_components() == 1)
+      return;
+    if (!stress_values || stress_values->n_quadrature_points != unit_points.size())
+      stress_values = std::make_unique<FEValues<dim>>(fe, Quadrature<dim>(unit_points), update_values);
+    stress_values->reinit(Fluid::FluidSpace<dim>::cell_of(cell, dof_handler));
+    std::vector<Vector<double>> values(unit_points.size(), Vector<double>(fe.n_components()));
+    stress_values->get_function_values(solution, values);
+    const double G = parameters.solid.shear_modulus;
+    for (unsigned int q = 0; q < unit_points.size(); ++q)
+      for (unsigned int c = 0; c < n_B; ++c)
+        {
+          const auto ij = SymmetricTensor<2, dim>::unrolled_to_component_indices(c);
+          stress[q][ij] += G * values[q][0] * (values[q][1 + c] - (ij[0] == ij[1] ? 1. : 0.));
+        }
+  }
+
+  template class SolidPhase<2>;
+  template class SolidPhase<3>;
+} // namespace Suspension::Solid

@@ -1,0 +1,314 @@
+#include <deal.II/base/symmetric_tensor.h>
+#include <deal.II/fe/mapping_q1.h>
+#include <deal.II/matrix_free/fe_evaluation.h>
+#include <deal.II/matrix_free/operators.h>
+
+#include <suspension/solid/transport_operator.h>
+
+#include <functional>
+#include <memory>
+
+namespace Suspension::Solid
+{
+  namespace
+  {
+    using VA = VectorizedArray<double>;
+
+    template <int dim>
+    SymmetricTensor<2, dim, VA> to_tensor(const Tensor<1, dim * (dim + 1) / 2, VA> &b)
+    {
+      SymmetricTensor<2, dim, VA> B;
+      for (unsigned int c = 0; c < b.dimension; ++c)
+        B[SymmetricTensor<2, dim>::unrolled_to_component_indices(c)] = b[c];
+      return B;
+    }
+
+    template <int dim>
+    Tensor<1, dim * (dim + 1) / 2, VA> to_vector(const Tensor<2, dim, VA> &B)
+    {
+      Tensor<1, dim * (dim + 1) / 2, VA> b;
+      for (unsigned int c = 0; c < b.dimension; ++c)
+        b[c] = B[SymmetricTensor<2, dim>::unrolled_to_component_indices(c)];
+      return b;
+    }
+
+    // upwind flux of a transported quantity: un > 0 takes the inside value
+    template <typename T>
+    T upwind(const VA &un, const T &inside, const T &outside)
+    {
+      return 0.5 * un * (inside + outside) + 0.5 * std::abs(un) * (inside - outside);
+    }
+  } // namespace
+
+  template <int dim>
+  void TransportOperator<dim>::reinit(const DoFHandler<dim>           &dof_solid,
+                                      const DoFHandler<dim>           &dof_velocity,
+                                      const AffineConstraints<double> &velocity_constraints,
+                                      const bool                       with_B_)
+  {
+    with_B = with_B_;
+    const unsigned int k   = dof_solid.get_fe().degree;
+    const unsigned int k_u = dof_velocity.get_fe().degree;
+    // (u phi, grad v) has degree k_u + 2k per direction: Gauss exact for it.
+    const unsigned int n_q = (k_u + 2 * k + 2) / 2;
+
+    typename MatrixFree<dim, double>::AdditionalData data;
+    data.tasks_parallel_scheme = MatrixFree<dim, double>::AdditionalData::none;
+    data.mapping_update_flags =
+      update_values | update_gradients | update_JxW_values | update_quadrature_points;
+    data.mapping_update_flags_inner_faces =
+      update_values | update_JxW_values | update_normal_vectors;
+    data.mapping_update_flags_boundary_faces =
+      update_values | update_JxW_values | update_normal_vectors;
+
+    const AffineConstraints<double> no_constraints;
+    const std::vector<const DoFHandler<dim> *>           dofs = {&dof_solid, &dof_velocity};
+    const std::vector<const AffineConstraints<double> *> constraints = {&no_constraints,
+                                                                        &velocity_constraints};
+    // quadrature 0: integrals; 1: k+1 Gauss points for the inverse mass
+    const std::vector<Quadrature<1>> quadratures = {QGauss<1>(n_q), QGauss<1>(k + 1)};
+    matrix_free.reinit(MappingQ1<dim>(), dofs, constraints, quadratures, data);
+  }
+
+  template <int dim>
+  void TransportOperator<dim>::initialize_solid_vector(VectorType &v) const
+  {
+    matrix_free.initialize_dof_vector(v, 0);
+  }
+
+  template <int dim>
+  void TransportOperator<dim>::initialize_velocity_vector(VectorType &v) const
+  {
+    matrix_free.initialize_dof_vector(v, 1);
+  }
+
+  template <int dim>
+  void TransportOperator<dim>::apply(const VectorType &src,
+                                     VectorType       &dst,
+                                     const VectorType &velocity) const
+  {
+    using Range = std::pair<unsigned int, unsigned int>;
+    using Operation =
+      std::function<void(const MatrixFree<dim, double> &, VectorType &, const VectorType &, const Range &)>;
+
+    const Operation cell_op = [&](const MatrixFree<dim, double> &mf, VectorType &out,
+                             const VectorType &in, const Range &range) {
+      FEEvaluation<dim, -1, 0, 1, double>   phi(mf, range, 0, 0, 0);
+      FEEvaluation<dim, -1, 0, dim, double> u(mf, range, 1, 0);
+      std::unique_ptr<FEEvaluation<dim, -1, 0, n_B, double>> b_ptr;
+      if (with_B)
+        b_ptr = std::make_unique<FEEvaluation<dim, -1, 0, n_B, double>>(mf, range, 0, 0, 1);
+      for (unsigned int cell = range.first; cell < range.second; ++cell)
+        {
+          u.reinit(cell);
+          u.read_dof_values_plain(velocity);
+          u.evaluate(EvaluationFlags::values | EvaluationFlags::gradients);
+          phi.reinit(cell);
+          phi.gather_evaluate(in, EvaluationFlags::values);
+          for (const unsigned int q : phi.quadrature_point_indices())
+            phi.submit_gradient(u.get_value(q) * phi.get_value(q), q);
+          phi.integrate_scatter(EvaluationFlags::gradients, out);
+          if (!with_B)
+            continue;
+          auto &b = *b_ptr;
+          b.reinit(cell);
+          b.gather_evaluate(in, EvaluationFlags::values);
+          for (const unsigned int q : b.quadrature_point_indices())
+            {
+              const auto velocity_q = u.get_value(q);
+              const auto grad_u     = u.get_gradient(q);
+              const auto bq         = b.get_value(q);
+              const auto B          = Tensor<2, dim, VA>(to_tensor<dim>(bq));
+              const auto source =
+                trace(grad_u) * B + grad_u * B + B * transpose(grad_u);
+              Tensor<1, n_B, Tensor<1, dim, VA>> flux;
+              for (unsigned int c = 0; c < n_B; ++c)
+                flux[c] = velocity_q * bq[c];
+              b.submit_gradient(flux, q);
+              b.submit_value(to_vector<dim>(source), q);
+            }
+          b.integrate_scatter(EvaluationFlags::values | EvaluationFlags::gradients, out);
+        }
+    };
+
+    const Operation face_op = [&](const MatrixFree<dim, double> &mf, VectorType &out,
+                             const VectorType &in, const Range &range) {
+      FEFaceEvaluation<dim, -1, 0, 1, double>   phi_m(mf, range, true, 0, 0, 0);
+      FEFaceEvaluation<dim, -1, 0, 1, double>   phi_p(mf, range, false, 0, 0, 0);
+      FEFaceEvaluation<dim, -1, 0, dim, double> u(mf, range, true, 1, 0);
+      using FaceB = FEFaceEvaluation<dim, -1, 0, n_B, double>;
+      std::unique_ptr<FaceB> bm_ptr, bp_ptr;
+      if (with_B)
+        {
+          bm_ptr = std::make_unique<FaceB>(mf, range, true, 0, 0, 1);
+          bp_ptr = std::make_unique<FaceB>(mf, range, false, 0, 0, 1);
+        }
+      for (unsigned int face = range.first; face < range.second; ++face)
+        {
+          u.reinit(face);
+          u.read_dof_values_plain(velocity);
+          u.evaluate(EvaluationFlags::values);
+          phi_m.reinit(face);
+          phi_p.reinit(face);
+          phi_m.gather_evaluate(in, EvaluationFlags::values);
+          phi_p.gather_evaluate(in, EvaluationFlags::values);
+          for (const unsigned int q : phi_m.quadrature_point_indices())
+            {
+              const VA un   = u.get_value(q) * phi_m.get_normal_vector(q);
+              const VA flux = upwind(un, phi_m.get_value(q), phi_p.get_value(q));
+              phi_m.submit_value(-flux, q);
+              phi_p.submit_value(flux, q);
+            }
+          phi_m.integrate_scatter(EvaluationFlags::values, out);
+          phi_p.integrate_scatter(EvaluationFlags::values, out);
+          if (!with_B)
+            continue;
+          auto &b_m = *bm_ptr;
+          auto &b_p = *bp_ptr;
+          b_m.reinit(face);
+          b_p.reinit(face);
+          b_m.gather_evaluate(in, EvaluationFlags::values);
+          b_p.gather_evaluate(in, EvaluationFlags::values);
+          for (const unsigned int q : b_m.quadrature_point_indices())
+            {
+              const VA   un   = u.get_value(q) * b_m.get_normal_vector(q);
+              const auto flux = upwind(un, b_m.get_value(q), b_p.get_value(q));
+              b_m.submit_value(-flux, q);
+              b_p.submit_value(flux, q);
+            }
+          b_m.integrate_scatter(EvaluationFlags::values, out);
+          b_p.integrate_scatter(EvaluationFlags::values, out);
+        }
+    };
+
+    const Operation boundary_op = [&](const MatrixFree<dim, double> &mf, VectorType &out,
+                                 const VectorType &in, const Range &range) {
+      FEFaceEvaluation<dim, -1, 0, 1, double>   phi(mf, range, true, 0, 0, 0);
+      FEFaceEvaluation<dim, -1, 0, dim, double> u(mf, range, true, 1, 0);
+      using FaceB = FEFaceEvaluation<dim, -1, 0, n_B, double>;
+      std::unique_ptr<FaceB> b_ptr;
+      if (with_B)
+        b_ptr = std::make_unique<FaceB>(mf, range, true, 0, 0, 1);
+      Tensor<1, n_B, VA> identity;
+      for (unsigned int d = 0; d < dim; ++d)
+        identity[d] = 1.; // unrolled order starts with the diagonal
+      for (unsigned int face = range.first; face < range.second; ++face)
+        {
+          u.reinit(face);
+          u.read_dof_values_plain(velocity);
+          u.evaluate(EvaluationFlags::values);
+          phi.reinit(face);
+          phi.gather_evaluate(in, EvaluationFlags::values);
+          for (const unsigned int q : phi.quadrature_point_indices())
+            {
+              const VA un = u.get_value(q) * phi.get_normal_vector(q);
+              phi.submit_value(-upwind(un, phi.get_value(q), VA(0.)), q);
+            }
+          phi.integrate_scatter(EvaluationFlags::values, out);
+          if (!with_B)
+            continue;
+          auto &b = *b_ptr;
+          b.reinit(face);
+          b.gather_evaluate(in, EvaluationFlags::values);
+          for (const unsigned int q : b.quadrature_point_indices())
+            {
+              const VA un = u.get_value(q) * b.get_normal_vector(q);
+              b.submit_value(-upwind(un, b.get_value(q), identity), q);
+            }
+          b.integrate_scatter(EvaluationFlags::values, out);
+        }
+    };
+
+    matrix_free.loop(cell_op, face_op, boundary_op, dst, src, true,
+                     MatrixFree<dim, double>::DataAccessOnFaces::values,
+                     MatrixFree<dim, double>::DataAccessOnFaces::values);
+
+    // dst <- M^{-1} dst, cell by cell (exact for FE_DGQ on affine cells)
+    const Operation inverse_mass = [&](const MatrixFree<dim, double> &mf, VectorType &out,
+                                       const VectorType &in, const Range &range) {
+        using CellB = FEEvaluation<dim, -1, 0, n_B, double>;
+        using InverseB = MatrixFreeOperators::CellwiseInverseMassMatrix<dim, -1, n_B, double>;
+        FEEvaluation<dim, -1, 0, 1, double> phi(mf, range, 0, 1, 0);
+        MatrixFreeOperators::CellwiseInverseMassMatrix<dim, -1, 1, double> inverse_phi(phi);
+        std::unique_ptr<CellB>    b_ptr;
+        std::unique_ptr<InverseB> inverse_b_ptr;
+        if (with_B)
+          {
+            b_ptr         = std::make_unique<CellB>(mf, range, 0, 1, 1);
+            inverse_b_ptr = std::make_unique<InverseB>(*b_ptr);
+          }
+        for (unsigned int cell = range.first; cell < range.second; ++cell)
+          {
+            phi.reinit(cell);
+            phi.read_dof_values(in);
+            inverse_phi.apply(phi.begin_dof_values(), phi.begin_dof_values());
+            phi.set_dof_values(out);
+            if (!with_B)
+              continue;
+            auto &b = *b_ptr;
+            b.reinit(cell);
+            b.read_dof_values(in);
+            inverse_b_ptr->apply(b.begin_dof_values(), b.begin_dof_values());
+            b.set_dof_values(out);
+          }
+      };
+    matrix_free.cell_loop(inverse_mass, dst, dst);
+  }
+
+  template <int dim>
+  LimiterReport TransportOperator<dim>::limit(VectorType &solution, const bool scale) const
+  {
+    LimiterReport                          report;
+    FEEvaluation<dim, -1, 0, 1, double>    phi(matrix_free, 0, 0, 0);
+    for (unsigned int cell = 0; cell < matrix_free.n_cell_batches(); ++cell)
+      {
+        phi.reinit(cell);
+        phi.read_dof_values(solution);
+        phi.evaluate(EvaluationFlags::values);
+        bool changed = false;
+        for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+          {
+            double integral = 0., volume = 0., lo = 1e300, hi = -1e300;
+            for (const unsigned int q : phi.quadrature_point_indices())
+              {
+                const double value = phi.get_value(q)[v];
+                integral += value * phi.JxW(q)[v];
+                volume += phi.JxW(q)[v];
+                lo = std::min(lo, value);
+                hi = std::max(hi, value);
+              }
+            for (unsigned int i = 0; i < phi.dofs_per_cell; ++i)
+              {
+                lo = std::min(lo, phi.begin_dof_values()[i][v]);
+                hi = std::max(hi, phi.begin_dof_values()[i][v]);
+              }
+            const double mean = integral / volume;
+            if (mean < 0. || mean > 1.)
+              ++report.out_of_bound_means;
+            double theta = 1.;
+            if (hi > 1. && hi > mean)
+              theta = std::min(theta, std::max(0., 1. - mean) / (hi - mean));
+            if (lo < 0. && lo < mean)
+              theta = std::min(theta, std::max(0., mean) / (mean - lo));
+            if (scale && theta < 1.)
+              {
+                ++report.limited_cells;
+                changed = true;
+                for (unsigned int i = 0; i < phi.dofs_per_cell; ++i)
+                  phi.begin_dof_values()[i][v] =
+                    mean + theta * (phi.begin_dof_values()[i][v] - mean);
+                lo = mean + theta * (lo - mean);
+                hi = mean + theta * (hi - mean);
+              }
+            report.min_phi = std::min(report.min_phi, lo);
+            report.max_phi = std::max(report.max_phi, hi);
+          }
+        if (changed)
+          phi.set_dof_values(solution);
+      }
+    return report;
+  }
+
+  template class TransportOperator<2>;
+  template class TransportOperator<3>;
+} // namespace Suspension::Solid
