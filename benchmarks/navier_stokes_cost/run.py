@@ -25,7 +25,11 @@ T_START = time.perf_counter()
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
 WORK = os.path.join(HERE, "work")
-SUSPENSION = os.path.join(REPO, "build", "suspension")
+BUILD = os.path.join(REPO, "build")
+# build/ may be rebuilt by someone else while this runs: the executable and
+# its library are copied to work/bin at the start and run from there.
+BIN = os.path.join(WORK, "bin")
+SUSPENSION = os.path.join(BIN, "suspension")
 
 # ---------------------------------------------------------------- settings
 # step-35: (n_of_refines, steps measured); measured steps are a multiple of
@@ -48,7 +52,8 @@ LOAD_MAX_WAIT = 120.0
 
 ENV = dict(os.environ,
            OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
-           OMP_NUM_THREADS="1", DEAL_II_NUM_THREADS="1")
+           OMP_NUM_THREADS="1", DEAL_II_NUM_THREADS="1",
+           LD_LIBRARY_PATH=BIN + os.pathsep + os.environ.get("LD_LIBRARY_PATH", ""))
 
 notes = []
 
@@ -294,10 +299,23 @@ def step35_cost_at(ref, dofs):
     return math.exp(y0 + (y1 - y0) * (x - x0) / (x1 - x0))
 
 
+def snapshot_suspension():
+    exe = os.path.join(BUILD, "suspension")
+    lib = os.path.join(BUILD, "libsuspension_lib.so")
+    if not os.path.isfile(exe):
+        sys.exit(f"error: {exe} missing; build the project first (scripts/run)")
+    shutil.rmtree(BIN, ignore_errors=True)
+    os.makedirs(BIN)
+    for f in (exe, lib):
+        if os.path.isfile(f):
+            shutil.copy2(f, BIN)
+    stamp = time.strftime("%Y-%m-%d %H:%M:%S", time.localtime(os.path.getmtime(exe)))
+    log(f"benchmarking a copy of build/suspension (built {stamp})")
+
+
 def main():
-    if not os.path.isfile(SUSPENSION):
-        sys.exit(f"error: {SUSPENSION} missing; build the project first (scripts/run)")
     os.makedirs(WORK, exist_ok=True)
+    snapshot_suspension()
     log(f"load average at start: {load1():.2f}")
 
     src = step35_source()

@@ -736,6 +736,14 @@ namespace Suspension::Parameters
                       "If set, the final phi is compared with this "
                       "expression of x, y[, z] (L1 error), e.g. the initial "
                       "shape after a full revolution.");
+    prm.declare_entry("Exact solid at probes",
+                      "",
+                      Patterns::Anything(),
+                      "If set, phi and the entries of B (order: B_11, B_22, "
+                      "[B_33,] B_12, [B_13, B_23]) expected at the probe "
+                      "points at the end, separated by ';'; the largest "
+                      "relative difference is printed and checked against "
+                      "'Tolerance'.");
     prm.declare_entry("Exact pressure",
                       "0",
                       Patterns::Anything(),
@@ -792,6 +800,7 @@ namespace Suspension::Parameters
     exact_velocity = {prm.get("Exact velocity"), prm.get("Function constants")};
     exact_pressure = prm.get("Exact pressure");
     exact_fraction = Utilities::trim(prm.get("Exact solid fraction"));
+    exact_solid_at_probes = Utilities::trim(prm.get("Exact solid at probes"));
     report_times   = to_doubles("Verification/Report times",
                               prm.get("Report times"));
     reference_data = prm.get("Reference data") == "none" ?
@@ -811,6 +820,9 @@ namespace Suspension::Parameters
                          1,
                          dim);
       }
+    if (!exact_solid_at_probes.empty())
+      check_expression("Verification/Exact solid at probes",
+                       {exact_solid_at_probes, exact_velocity.constants}, 1 + dim * (dim + 1) / 2, dim);
     if (!exact_fraction.empty())
       check_expression("Verification/Exact solid fraction",
                        {exact_fraction, exact_velocity.constants}, 1, dim);

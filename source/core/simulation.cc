@@ -45,6 +45,10 @@ namespace Suspension
     , verification(parameters)
   {
     fluid.set_timer(timer);
+    if (parameters.fluid_solver.mode == Parameters::VelocityMode::prescribed)
+      prescribed_velocity = make_function<dim>(parameters.fluid_solver.prescribed_velocity, dim);
+    if (parameters.solid.enabled())
+      solid = std::make_unique<Solid::SolidPhase<dim>>(parameters, triangulation);
     if (!parameters.flow_driving.body_force.is_zero())
       body_force = std::make_unique<Fluid::BodyForce<dim>>(
         make_function<dim>(parameters.flow_driving.body_force, dim));
@@ -56,8 +60,22 @@ namespace Suspension
     TimerOutput::Scope scope(timer, "setup (mesh, DoFs, matrices)");
     scene.create_mesh(triangulation);
     space.setup(scene);
-    operators.reinit(space);
-    fluid.initialize();
+    // a prescribed velocity needs the velocity space, but no matrix
+    if (!prescribed_velocity)
+      operators.reinit(space);
+    fluid.initialize(prescribed_velocity.get());
+    if (solid)
+      solid->setup(space);
+  }
+
+  template <int dim>
+  double Simulation<dim>::smallest_cell() const
+  {
+    double h = std::numeric_limits<double>::max();
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+        h = std::min(h, cell->minimum_vertex_distance());
+    return Utilities::MPI::min(h, communicator);
   }
 
   template <int dim>
@@ -74,6 +92,11 @@ namespace Suspension
         if (cfl > ts.cfl || cfl < 0.5 * ts.cfl)
           next = std::min(ts.maximum_time_step, 0.9 * ts.cfl / d.max_speed_over_h);
       }
+    // The explicit elastic stress: an elastic wave may not cross a cell.
+    if (solid && parameters.solid.elastic() && !prescribed_velocity)
+      next = std::min(next, parameters.solid.elastic_number * smallest_cell() /
+                              std::sqrt(parameters.solid.shear_modulus /
+                                        parameters.material.density));
     // Land exactly on report times and on the end time.
     std::vector<double> targets = parameters.verification.report_times;
     targets.push_back(ts.end_time);
@@ -100,8 +123,14 @@ namespace Suspension
     TimerOutput::Scope scope(timer, "output");
     last_output_time = fluid.time();
     if (parameters.output.write_vtu)
-      field_output.write(space, fluid.velocity(), fluid.kinematic_pressure(),
-                         parameters.material.density, fluid.time());
+      {
+        std::vector<Postprocess::ExtraField<dim>> extra;
+        if (solid)
+          extra.push_back({&solid->get_dof_handler(), &solid->get_solution(),
+                           solid->component_names()});
+        field_output.write(space, fluid.velocity(), fluid.kinematic_pressure(),
+                           parameters.material.density, fluid.time(), extra);
+      }
     write_probes();
   }
 
@@ -131,6 +160,18 @@ namespace Suspension
         for (unsigned int d = 0; d < dim; ++d)
           line << (d > 0 ? ", " : "") << u[k][d];
         line << "), p = " << parameters.material.density * p[k][0];
+        if (solid)
+          {
+            const auto names  = solid->component_names();
+            const auto values = solid->values_at({points[k]});
+            for (unsigned int c = 0; c < names.size(); ++c)
+              {
+                line << ", " << names[c] << " = " << values[0][c];
+                probes.add_value(names[c], values[0][c]);
+                probes.set_scientific(names[c], true);
+                probes.set_precision(names[c], 12);
+              }
+          }
         last_probe_values.push_back(line.str());
         probes.add_value("time", fluid.time());
         probes.add_value("probe", k);
@@ -167,6 +208,104 @@ namespace Suspension
       {
         statistics.set_scientific(c, true);
         statistics.set_precision(c, 8);
+      }
+  }
+
+  template <int dim>
+  void Simulation<dim>::add_solid_statistics(const Solid::SolidDiagnostics &d)
+  {
+    statistics.add_value("solid_volume", d.volume);
+    statistics.add_value("volume_drift", d.volume_drift);
+    statistics.add_value("phi_min", d.min_phi);
+    statistics.add_value("phi_max", d.max_phi);
+    statistics.add_value("limited_cells", d.limited_cells);
+    statistics.add_value("bad_means", d.out_of_bound_means);
+    statistics.add_value("substeps", d.substeps);
+    std::vector<std::string> columns = {"solid_volume", "volume_drift", "phi_min", "phi_max"};
+    if (parameters.solid.elastic())
+      {
+        statistics.add_value("detB_min", d.min_det_B);
+        statistics.add_value("eigB_min", d.min_eigenvalue_B);
+        columns.push_back("detB_min");
+        columns.push_back("eigB_min");
+      }
+    if (parameters.solid.particles.size() == 1)
+      {
+        const auto shape = solid->particle_shape(space, fluid.velocity());
+        static const char *x[] = {"x_c", "y_c", "z_c"}, *u[] = {"u_c", "v_c", "w_c"};
+        for (unsigned int d = 0; d < dim; ++d)
+          {
+            statistics.add_value(x[d], shape.centroid[d]);
+            statistics.add_value(u[d], shape.velocity[d]);
+            columns.push_back(x[d]);
+            columns.push_back(u[d]);
+          }
+        statistics.add_value("D", shape.taylor_deformation);
+        statistics.add_value("theta_deg", shape.inclination);
+        statistics.add_value("solid_area", shape.solid_area);
+        columns.insert(columns.end(), {"D", "theta_deg", "solid_area"});
+      }
+    for (const auto &c : columns)
+      {
+        statistics.set_scientific(c, true);
+        statistics.set_precision(c, 10);
+      }
+  }
+
+  template <int dim>
+  void Simulation<dim>::report_solid()
+  {
+    const auto &d = solid_diagnostics;
+    pcout << "  solid: volume " << std::scientific << std::setprecision(8) << d.volume
+          << ", relative drift " << std::setprecision(2) << d.volume_drift << ", phi in ["
+          << std::setprecision(6) << d.min_phi << ", " << d.max_phi << "]" << std::defaultfloat
+          << std::endl;
+    pcout << "  mass drift <= 1e-12: " << (std::abs(d.volume_drift) <= 1e-12 ? "yes" : "no")
+          << ", 0 <= phi <= 1: "
+          << (d.min_phi >= -1e-14 && d.max_phi <= 1. + 1e-14 ? "yes" : "no") << std::endl;
+    if (parameters.solid.elastic())
+      pcout << "  B: min det " << std::scientific << std::setprecision(6) << d.min_det_B
+            << ", min eigenvalue " << d.min_eigenvalue_B << std::defaultfloat << std::endl;
+    if (parameters.solid.particles.size() == 1)
+      {
+        const auto s = solid->particle_shape(space, fluid.velocity());
+        pcout << "  particle: centroid (" << std::fixed << std::setprecision(4) << s.centroid
+              << "), Taylor deformation D = " << s.taylor_deformation << ", inclination "
+              << std::setprecision(2) << s.inclination << " deg" << std::defaultfloat << std::endl;
+      }
+    const auto &v = parameters.verification;
+    if (!v.exact_solid_at_probes.empty() && !parameters.output.probe_points.empty())
+      {
+        auto exact = make_function<dim>({v.exact_solid_at_probes, v.exact_velocity.constants},
+                                        1 + Solid::SolidPhase<dim>::n_B);
+        exact->set_time(fluid.time());
+        double worst = 0.;
+        for (const auto &c : parameters.output.probe_points)
+          {
+            Point<dim> p;
+            for (unsigned int d = 0; d < dim; ++d)
+              p[d] = c[d];
+            const auto values = solid->values_at({p});
+            for (unsigned int k = 0; k < values[0].size(); ++k)
+              {
+                const double e = exact->value(p, k);
+                worst = std::max(worst, std::abs(values[0][k] - e) / std::max(1., std::abs(e)));
+              }
+          }
+        pcout << "  solid fields at probes: largest relative error " << std::scientific
+              << std::setprecision(2) << worst << std::defaultfloat << std::endl;
+        if (v.tolerance > 0)
+          pcout << "  <= " << v.tolerance << ": " << (worst <= v.tolerance ? "yes" : "no")
+                << std::endl;
+      }
+    if (!parameters.verification.exact_fraction.empty())
+      {
+        const auto exact = make_function<dim>(
+          {parameters.verification.exact_fraction, parameters.verification.exact_velocity.constants},
+          1);
+        phi_l1_error = solid->l1_error(*exact);
+        pcout << "  phi L1 error " << std::scientific << std::setprecision(4) << phi_l1_error
+              << std::defaultfloat << std::endl;
       }
   }
 
@@ -261,6 +400,10 @@ namespace Suspension
     std::vector<const Fluid::MomentumSource<dim> *> sources;
     if (body_force)
       sources.push_back(body_force.get());
+    if (solid && parameters.solid.elastic())
+      sources.push_back(solid.get());
+    if (solid)
+      solid_diagnostics = solid->diagnostics();
 
     const auto &ts      = parameters.time_stepping;
     double      dt      = ts.time_step;
@@ -277,7 +420,28 @@ namespace Suspension
         dt = choose_time_step(dt, fluid.time(), diagnostics);
 
         Fluid::StepReport report;
-        report = fluid.advance(dt, sources);
+        if (prescribed_velocity)
+          {
+            const Fluid::VectorType u_begin = fluid.velocity();
+            fluid.prescribe(dt, *prescribed_velocity);
+            if (solid)
+              {
+                TimerOutput::Scope scope(timer, "solid transport");
+                solid_diagnostics =
+                  solid->advance(dt, diagnostics.max_speed_over_h, u_begin, fluid.velocity());
+              }
+          }
+        else
+          {
+            if (solid)
+              {
+                TimerOutput::Scope scope(timer, "solid transport");
+                solid_diagnostics = solid->advance(dt, diagnostics.max_speed_over_h,
+                                                   fluid.velocity(),
+                                                   fluid.extrapolated_velocity(dt));
+              }
+            report = fluid.advance(dt, sources);
+          }
         {
           TimerOutput::Scope scope(timer, "diagnostics");
           diagnostics = fluid.compute_diagnostics();
@@ -295,6 +459,8 @@ namespace Suspension
         const double wall =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count();
         add_statistics_row(report, diagnostics, dt, wall);
+        if (solid)
+          add_solid_statistics(solid_diagnostics);
         last_driving_force = report.driving_force;
 
         for (const double t : report_times)
@@ -325,6 +491,8 @@ namespace Suspension
     pcout << std::defaultfloat << std::endl;
     for (const auto &line : last_probe_values)
       pcout << line << std::endl;
+    if (solid)
+      report_solid();
     report_errors(fluid.time(), steady);
     report_verdicts(steady);
     if (parameters.verification.reference_data == Parameters::ReferenceData::ghia_re100)
@@ -341,6 +509,7 @@ namespace Suspension
     RunSummary summary;
     summary.final_errors = last_errors;
     summary.errors       = error_history;
+    summary.phi_l1_error = phi_l1_error;
     double h = std::numeric_limits<double>::max();
     for (const auto &cell : triangulation.active_cell_iterators())
       if (cell->is_locally_owned())

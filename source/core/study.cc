@@ -60,11 +60,18 @@ namespace Suspension
       for (const auto &[t, e] : r.errors)
         largest_pressure_error = std::max(largest_pressure_error, e.pressure_l2);
     const bool     with_pressure = largest_pressure_error > 1e-10;
+    const bool     with_phi      = runs.front().phi_l1_error >= 0.;
     ConvergenceTable table;
     std::vector<std::string> columns;
     for (const auto &r : runs)
       {
         table.add_value(key, in_space ? r.smallest_cell : r.time_step);
+        if (with_phi)
+          {
+            table.add_value("phi L1", r.phi_l1_error);
+            if (&r == &runs.front())
+              columns.push_back("phi L1");
+          }
         for (unsigned int k = 0; k < r.errors.size() && k < reported.size(); ++k)
           {
             std::ostringstream t;
@@ -93,6 +100,13 @@ namespace Suspension
     pcout << std::endl << (in_space ? "mesh" : "time-step") << " convergence:" << std::endl;
     if (Utilities::MPI::this_mpi_process(communicator) == 0)
       table.write_text(std::cout);
+
+    if (with_phi)
+      pcout << std::fixed << std::setprecision(2) << "final phi L1 rate: "
+            << std::log2(runs[runs.size() - 2].phi_l1_error / runs.back().phi_l1_error)
+            << std::defaultfloat << std::endl;
+    if (reported.empty())
+      return;
 
     // Rate between the last two cycles (the asymptotic one), final time.
     const auto &a = runs[runs.size() - 2].final_errors, &b = runs.back().final_errors;

@@ -80,7 +80,8 @@ namespace Suspension::Postprocess
                                const Fluid::VectorType      &velocity,
                                const Fluid::VectorType      &kinematic_pressure,
                                const double                  density,
-                               const double                  time)
+                               const double                  time,
+                               const std::vector<ExtraField<dim>> &extra_fields)
   {
     const auto &tria = space.triangulation;
     DataOut<dim> data_out;
@@ -96,6 +97,9 @@ namespace Suspension::Postprocess
 
     ScaledPressure<dim> pressure(density);
     data_out.add_data_vector(space.dof_pressure, kinematic_pressure, pressure);
+
+    for (const auto &field : extra_fields)
+      data_out.add_data_vector(*field.dof_handler, *field.vector, field.names);
 
     Vector<float> rank(tria.n_active_cells()), level(tria.n_active_cells());
     for (const auto &cell : tria.active_cell_iterators())

@@ -184,7 +184,7 @@ namespace Suspension::Parameters
     double                           shear_modulus = 0.;
     unsigned int                     degree        = 1;
     bool                             limiter       = true;
-    double                           transport_cfl = 0.2;
+    double                           transport_cfl = 0.5;
     double                           elastic_number = 0.5;
 
     bool enabled() const { return initial_fraction != InitialFraction::none; }
@@ -240,6 +240,7 @@ namespace Suspension::Parameters
   {
     ExactSolutionType   exact_solution = ExactSolutionType::none;
     std::string         exact_fraction; // compared in L1 at the end
+    std::string         exact_solid_at_probes; // phi; B components
     FunctionExpression  exact_velocity{"", ""};
     std::string         exact_pressure;
     std::vector<double> report_times;

@@ -12,6 +12,7 @@
 #include <suspension/fluid/projection_scheme.h>
 #include <suspension/postprocess/field_output.h>
 #include <suspension/postprocess/flow_verification.h>
+#include <suspension/solid/solid_phase.h>
 
 #include <memory>
 #include <vector>
@@ -22,6 +23,7 @@ namespace Suspension
   struct RunSummary
   {
     Postprocess::FlowErrors final_errors;
+    double                  phi_l1_error = -1.; // < 0: not computed
     /// errors at the report times and at the end, in time order
     std::vector<std::pair<double, Postprocess::FlowErrors>> errors;
     double                  smallest_cell = 0.;
@@ -50,6 +52,9 @@ namespace Suspension
     void   write_probes();
     void   add_statistics_row(const Fluid::StepReport &r, const Fluid::FlowDiagnostics &d,
                               double dt, double wall_time);
+    void   add_solid_statistics(const Solid::SolidDiagnostics &d);
+    void   report_solid();
+    double smallest_cell() const;
     void   report_errors(double time, bool steady);
     void   report_verdicts(bool steady);
     void   print_progress(double dt, const Fluid::FlowDiagnostics &d, double elapsed) const;
@@ -65,6 +70,10 @@ namespace Suspension
     Fluid::FluidOperators<dim>                operators;
     Fluid::ProjectionScheme<dim>              fluid;
     std::unique_ptr<Fluid::MomentumSource<dim>> body_force;
+    std::unique_ptr<Function<dim>>            prescribed_velocity;
+    std::unique_ptr<Solid::SolidPhase<dim>>   solid;
+    Solid::SolidDiagnostics                   solid_diagnostics;
+    double                                    phi_l1_error = -1.;
     Postprocess::FieldOutput<dim>             field_output;
     Postprocess::FlowVerification<dim>        verification;
     TableHandler                              statistics, probes;

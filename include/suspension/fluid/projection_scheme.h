@@ -63,11 +63,20 @@ namespace Suspension::Fluid
     /// Optional: time the sub-steps in these sections.
     void set_timer(TimerOutput &timer) { this->timer = &timer; }
 
-    /// Allocates the time levels and sets u^0 from the scene, P^0 = 0.
-    void initialize();
+    /// Allocates the time levels and sets u^0 from the scene (or from
+    /// `velocity`, a prescribed field, as it is), P^0 = 0.
+    void initialize(Function<dim> *velocity = nullptr);
 
     /// Advances from the current time by dt.
     StepReport advance(double dt, const std::vector<const MomentumSource<dim> *> &sources);
+
+    /// Prescribed-velocity mode: u^{n+1} is the interpolant of `velocity`
+    /// at t + dt; nothing is solved and no matrix is needed.
+    void prescribe(double dt, Function<dim> &velocity);
+
+    /// Velocity extrapolated to t + dt from the last two levels (for the
+    /// transport of the solid over the coming step).
+    VectorType extrapolated_velocity(double dt) const;
 
     FlowDiagnostics compute_diagnostics() const;
 

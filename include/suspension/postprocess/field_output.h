@@ -1,5 +1,7 @@
 #pragma once
 
+#include <deal.II/lac/la_parallel_vector.h>
+
 #include <suspension/fluid/fluid_space.h>
 #include <suspension/fluid/fluid_operators.h>
 
@@ -16,6 +18,15 @@ namespace Suspension::Postprocess
    * (velocity, pressure, vorticity, MPI rank, refinement level) and keeps
    * a .pvd index of all steps for ParaView, rewritten each time.
    */
+  /// A further field on its own DoFHandler (e.g. phi and B of the solid).
+  template <int dim>
+  struct ExtraField
+  {
+    const DoFHandler<dim>                            *dof_handler;
+    const LinearAlgebra::distributed::Vector<double> *vector;
+    std::vector<std::string>                          names;
+  };
+
   template <int dim>
   class FieldOutput
   {
@@ -26,7 +37,8 @@ namespace Suspension::Postprocess
                const Fluid::VectorType      &velocity,
                const Fluid::VectorType      &kinematic_pressure,
                double                        density,
-               double                        time);
+               double                        time,
+               const std::vector<ExtraField<dim>> &extra_fields = {});
 
   private:
     std::string                                  directory;

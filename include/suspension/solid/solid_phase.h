@@ -4,6 +4,7 @@
 #include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_system.h>
+#include <deal.II/fe/fe_values.h>
 
 #include <suspension/core/parameters.h>
 #include <suspension/fluid/fluid_operators.h>
