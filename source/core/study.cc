@@ -74,8 +74,13 @@ namespace Suspension
           }
         for (unsigned int k = 0; k < r.errors.size() && k < reported.size(); ++k)
           {
+            // the last entry is the end of the run (possibly a steady state
+            // whose time may differ between platforms: not printed)
             std::ostringstream t;
-            t << std::setprecision(6) << "t=" << reported[k].first;
+            if (k + 1 == reported.size())
+              t << "final";
+            else
+              t << std::setprecision(6) << "t=" << reported[k].first;
             table.add_value("u L2 " + t.str(), r.errors[k].second.velocity_l2);
             if (k == 0 && &r == &runs.front())
               columns.push_back("u L2 " + t.str());

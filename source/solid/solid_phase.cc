@@ -199,6 +199,7 @@ namespace Suspension::Solid
         limit(solution);
       }
     time += dt;
+    reset_B_in_fluid();
 
     SolidDiagnostics d     = diagnostics();
     d.limited_cells        = Utilities::MPI::sum(report.limited_cells, dof_handler.get_communicator());
@@ -228,7 +229,8 @@ namespace Suspension::Solid
               volume += values[q][0] * fe_values.JxW(q);
               lo = std::min(lo, values[q][0]);
               hi = std::max(hi, values[q][0]);
-              if (nc > 1)
+              // B means something only where there is solid
+              if (nc > 1 && values[q][0] >= solid_threshold)
                 {
                   SymmetricTensor<2, dim> B;
                   for (unsigned int c = 0; c < n_B; ++c)
@@ -257,6 +259,36 @@ namespace Suspension::Solid
         d.min_eigenvalue_B = Utilities::MPI::min(eig_min, comm);
       }
     return d;
+  }
+
+  template <int dim>
+  void SolidPhase<dim>::reset_B_in_fluid()
+  {
+    // Pure fluid keeps no memory of deformation: in cells without solid
+    // (phi below 1e-6 at every node) B is set back to I. Otherwise B would
+    // grow without bound in sheared fluid (B_11 = 1 + (shear t)^2) and its
+    // discretization errors, which the stress G phi (B - I) never sees,
+    // would end the run through the SPD check.
+    if (fe.n_components() == 1)
+      return;
+    std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          cell->get_dof_indices(dofs);
+          bool fluid = true;
+          for (unsigned int i = 0; i < dofs.size() && fluid; ++i)
+            if (fe.system_to_component_index(i).first == 0)
+              fluid = std::abs(solution(dofs[i])) < 1e-6;
+          if (!fluid)
+            continue;
+          for (unsigned int i = 0; i < dofs.size(); ++i)
+            {
+              const unsigned int c = fe.system_to_component_index(i).first;
+              if (c > 0)
+                solution(dofs[i]) = (c <= dim ? 1. : 0.);
+            }
+        }
   }
 
   template <int dim>

@@ -96,6 +96,10 @@ namespace Suspension::Solid
 
   private:
     void check_B(const SolidDiagnostics &d, double time) const;
+    void reset_B_in_fluid();
+
+    /// B is checked (SPD) where phi is at least this.
+    static constexpr double solid_threshold = 1e-3;
     void copy_velocity(const Fluid::VectorType &in, VectorType &out) const;
 
     const Parameters::All &parameters;
