@@ -67,21 +67,44 @@ def load1():
         return float(f.read().split()[0])
 
 
+# The 1-minute load average is an exponential average (time constant 60 s),
+# so right after one of our own runs it still counts that run.  That
+# residual is estimated and subtracted: only load from other processes
+# delays a run.
+LAST_RUN = None  # (ranks, duration, end time) of our previous timed run
+
+
+def own_residual_load():
+    if LAST_RUN is None:
+        return 0.0
+    ranks, duration, end = LAST_RUN
+    return ranks * (1 - math.exp(-duration / 60)) * math.exp(-(time.perf_counter() - end) / 60)
+
+
 def wait_for_quiet(label):
-    """Wait until the 1-minute load average is below LOAD_LIMIT."""
+    """Wait until the 1-minute load average, less the estimated residual of
+    our own previous run, is below LOAD_LIMIT; give up after LOAD_MAX_WAIT."""
     t0 = time.perf_counter()
-    while load1() >= LOAD_LIMIT:
+    while load1() - own_residual_load() >= LOAD_LIMIT:
         if time.perf_counter() - t0 > LOAD_MAX_WAIT:
-            note = (f"{label}: load average still {load1():.2f} after "
-                    f"{LOAD_MAX_WAIT:.0f} s, ran anyway")
+            note = (f"{label}: load average {load1():.2f} (own residual "
+                    f"{own_residual_load():.2f}) after waiting {LOAD_MAX_WAIT:.0f} s, ran anyway")
             notes.append(note)
             log("NOTE " + note)
             return load1()
         time.sleep(2)
     waited = time.perf_counter() - t0
     if waited > 1:
-        log(f"waited {waited:.0f} s for load average < {LOAD_LIMIT}")
-    return load1()
+        log(f"waited {waited:.0f} s for quiet load")
+    return load1() - own_residual_load()
+
+
+def finished_run(ranks, t0):
+    """Record a timed run; return the load average in excess of our own ranks."""
+    global LAST_RUN
+    now = time.perf_counter()
+    LAST_RUN = (ranks, now - t0, now)
+    return load1() - own_residual_load()
 
 
 # ---------------------------------------------------------------- step-35
@@ -153,7 +176,7 @@ def run_step35(build, exe, refines, n_measured):
     prm = set_prm(prm, "verbose", "false")
     open(os.path.join(run_dir, "parameter-file.prm"), "w").write(prm)
 
-    wait_for_quiet(f"step-35 r={refines}")
+    load_before = wait_for_quiet(f"step-35 r={refines}")
     t0 = time.perf_counter()
     proc = subprocess.Popen([exe], cwd=run_dir, env=ENV, stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, text=True, bufsize=1)
@@ -166,6 +189,7 @@ def run_step35(build, exe, refines, n_measured):
             stamps[int(m.group(1))] = now
     proc.wait()
     total = time.perf_counter() - t0
+    load_after = finished_run(1, t0)
     text = "".join(out)
     open(os.path.join(run_dir, "output.log"), "w").write(text)
     if proc.returncode != 0 or "Apparently everything went fine" not in text:
@@ -177,7 +201,8 @@ def run_step35(build, exe, refines, n_measured):
     return dict(code="step-35", dim=2, ranks=1, refinements=refines, dofs=nx + nm,
                 dt=dt, steps=n_measured, sec_per_step=(stamps[last] - stamps[first]) / n_measured,
                 sec_min=min(per_step), sec_max=max(per_step),
-                setup_s=stamps[first] - t0, total_s=total, cfl="", its="")
+                setup_s=stamps[first] - t0, total_s=total, cfl="", its="",
+                load_before=load_before, load_after=load_after)
 
 
 # ---------------------------------------------------------------- ours
@@ -257,10 +282,11 @@ def run_ours(dim, refines, ranks, n_measured):
     cmd = [SUSPENSION, prm_file]
     if ranks > 1:
         cmd = ["mpirun", "-np", str(ranks)] + cmd
-    wait_for_quiet(name)
+    load_before = wait_for_quiet(name)
     t0 = time.perf_counter()
     res = subprocess.run(cmd, env=ENV, capture_output=True, text=True, cwd=WORK)
     total = time.perf_counter() - t0
+    load_after = finished_run(ranks, t0)
     open(os.path.join(out_dir, "output.log"), "w").write(res.stdout + res.stderr)
     if res.returncode != 0:
         sys.exit(f"error: {name} failed (exit {res.returncode}), see {out_dir}/output.log")
@@ -283,7 +309,7 @@ def run_ours(dim, refines, ranks, n_measured):
                 sec_mean=statistics.fmean(wt_meas), sec_min=min(wt_meas), sec_max=max(wt_meas),
                 setup_s=total - sum(wt), first_steps_s=sum(wt[:OURS_SKIP]), total_s=total,
                 cfl=f"{max(r[cols['CFL']] for r in meas):.3f}", its=its,
-                its_range=its_range)
+                its_range=its_range, load_before=load_before, load_after=load_after)
 
 
 # ---------------------------------------------------------------- analysis
@@ -325,14 +351,15 @@ def main():
     for refines, n in STEP35_CASES:
         r = run_step35(build, exe, refines, n)
         log(f"step-35 r={refines}: {r['dofs']} DoFs, {r['sec_per_step']:.4f} s/step "
-            f"(setup {r['setup_s']:.1f} s)")
+            f"(setup {r['setup_s']:.1f} s), foreign load {r['load_before']:.2f} -> {r['load_after']:.2f}")
         results.append(r)
     for dim, refines, n in OURS_CASES:
         for ranks in RANKS:
             r = run_ours(dim, refines, ranks, n)
             log(f"ours {dim}D r={refines} np={ranks}: {r['dofs']} DoFs, "
                 f"{r['sec_per_step']:.4f} s/step (mean {r['sec_mean']:.4f}), its {r['its']}, "
-                f"CFL {r['cfl']}, run {r['total_s']:.1f} s")
+                f"CFL {r['cfl']}, run {r['total_s']:.1f} s, foreign load "
+                f"{r['load_before']:.2f} -> {r['load_after']:.2f}")
             results.append(r)
 
     for r in results:
@@ -371,7 +398,8 @@ def main():
     # ---- csv
     fields = ["code", "dim", "ranks", "refinements", "dofs", "dt", "cfl", "steps",
               "sec_per_step", "us_per_step_per_dof", "ratio_to_step35", "sec_min", "sec_max",
-              "sec_mean", "setup_s", "total_s", "median_its_mom_proj_mass"]
+              "sec_mean", "setup_s", "total_s", "median_its_mom_proj_mass",
+              "foreign_load_before", "foreign_load_after"]
     with open(os.path.join(HERE, "results.csv"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(fields)
@@ -382,7 +410,8 @@ def main():
                         f"{r['ratio']:.4g}" if r["ratio"] != "" else "",
                         f"{r['sec_min']:.6g}", f"{r['sec_max']:.6g}",
                         f"{r.get('sec_mean', r['sec_per_step']):.6g}",
-                        f"{r['setup_s']:.3g}", f"{r['total_s']:.3g}", r["its"]])
+                        f"{r['setup_s']:.3g}", f"{r['total_s']:.3g}", r["its"],
+                        f"{r['load_before']:.2f}", f"{r['load_after']:.2f}"])
 
     # ---- plot
     import matplotlib

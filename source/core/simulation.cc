@@ -467,7 +467,10 @@ namespace Suspension
           if (std::abs(t - fluid.time()) < 1e-9 * dt)
             report_errors(fluid.time(), false);
         if (output_due(fluid.time(), dt))
-          write_output();
+          {
+            write_output();
+            write_tables();
+          }
         const auto &o = parameters.output;
         if (o.progress_interval > 0 && fluid.step_number() % o.progress_interval == 0)
           {
