@@ -26,6 +26,19 @@ namespace Suspension
     }
   } // namespace
 
+  namespace
+  {
+    template <int dim>
+    std::string describe(const Solid::ParticleShape<dim> &s)
+    {
+      std::ostringstream out;
+      out << "particle centroid (" << std::fixed << std::setprecision(4) << s.centroid
+          << "), D = " << s.taylor_deformation << ", inclination " << std::setprecision(2)
+          << s.inclination << " deg, area(phi >= 1/2) " << std::setprecision(5) << s.solid_area;
+      return out.str();
+    }
+  } // namespace
+
   template <int dim>
   Simulation<dim>::Simulation(const Parameters::All &parameters, MPI_Comm communicator)
     : parameters(parameters)
@@ -268,10 +281,8 @@ namespace Suspension
             << ", min eigenvalue " << d.min_eigenvalue_B << std::defaultfloat << std::endl;
     if (parameters.solid.particles.size() == 1)
       {
-        const auto s = solid->particle_shape(space, fluid.velocity());
-        pcout << "  particle: centroid (" << std::fixed << std::setprecision(4) << s.centroid
-              << "), Taylor deformation D = " << s.taylor_deformation << ", inclination "
-              << std::setprecision(2) << s.inclination << " deg" << std::defaultfloat << std::endl;
+        pcout << "  final: " << describe(solid->particle_shape(space, fluid.velocity()))
+              << std::endl;
       }
     const auto &v = parameters.verification;
     if (!v.exact_solid_at_probes.empty() && !parameters.output.probe_points.empty())
@@ -465,7 +476,12 @@ namespace Suspension
 
         for (const double t : report_times)
           if (std::abs(t - fluid.time()) < 1e-9 * dt)
-            report_errors(fluid.time(), false);
+            {
+              report_errors(fluid.time(), false);
+              if (solid && parameters.solid.particles.size() == 1)
+                pcout << "  t = " << fluid.time() << ": "
+                      << describe(solid->particle_shape(space, fluid.velocity())) << std::endl;
+            }
         if (output_due(fluid.time(), dt))
           {
             write_output();
