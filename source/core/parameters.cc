@@ -776,6 +776,23 @@ namespace Suspension::Parameters
                       "0",
                       Patterns::Double(0.),
                       "The same for the pressure L2 error.");
+    prm.declare_entry("Sweep entry",
+                      "",
+                      Patterns::Anything(),
+                      "Run the scene once per value in 'Sweep values' of this "
+                      "entry (a path such as 'Solid/Shear modulus') and print "
+                      "the single particle's final deformation per value.");
+    prm.declare_entry("Sweep values",
+                      "",
+                      Patterns::Anything(),
+                      "Values for 'Sweep entry', separated by ','.");
+    prm.declare_entry("Sweep expected deformation",
+                      "",
+                      Patterns::Anything(),
+                      "Expected Taylor deformation D as a function of x, the "
+                      "swept value; with 'Tolerance' the relative deviation "
+                      "of the last run (the finest, by convention) is "
+                      "checked.");
     prm.declare_entry("Refinement cycles",
                       "1",
                       Patterns::Integer(1, 8),
@@ -810,6 +827,9 @@ namespace Suspension::Parameters
     minimum_velocity_rate = prm.get_double("Minimum velocity rate");
     minimum_pressure_rate = prm.get_double("Minimum pressure rate");
     refinement_cycles = prm.get_integer("Refinement cycles");
+    sweep_entry       = Utilities::trim(prm.get("Sweep entry"));
+    sweep_values      = split(prm.get("Sweep values"), ',');
+    sweep_expected_deformation = Utilities::trim(prm.get("Sweep expected deformation"));
     time_step_cycles  = prm.get_integer("Time step cycles");
     prm.leave_subsection();
     if (exact_solution == ExactSolutionType::function)
@@ -826,6 +846,8 @@ namespace Suspension::Parameters
     if (!exact_fraction.empty())
       check_expression("Verification/Exact solid fraction",
                        {exact_fraction, exact_velocity.constants}, 1, dim);
+    if (!sweep_entry.empty() && sweep_values.empty())
+      throw InputError("Verification/Sweep values", "a sweep needs values");
     if (refinement_cycles > 1 && time_step_cycles > 1)
       throw InputError("Verification/Time step cycles",
                        "a study refines either the mesh or the time step, "
@@ -898,11 +920,28 @@ namespace Suspension::Parameters
     return prm.get_integer("Dimension");
   }
 
-  All read(const std::string &filename, const unsigned int dim)
+  All read(const std::string &filename, const unsigned int dim,
+           const std::vector<std::pair<std::string, std::string>> &overrides)
   {
     ParameterHandler prm;
     All::declare(prm, dim);
     prm.parse_input(filename);
+    for (const auto &[path, value] : overrides)
+      {
+        const auto parts = Utilities::split_string_list(path, '/');
+        for (unsigned int i = 0; i + 1 < parts.size(); ++i)
+          prm.enter_subsection(parts[i]);
+        try
+          {
+            prm.set(parts.back(), value);
+          }
+        catch (...)
+          {
+            throw InputError(path, "cannot be set to '" + value + "'");
+          }
+        for (unsigned int i = 0; i + 1 < parts.size(); ++i)
+          prm.leave_subsection();
+      }
     All all;
     all.parse(prm, dim);
     all.input_file = filename;

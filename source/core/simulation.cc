@@ -529,6 +529,12 @@ namespace Suspension
     summary.final_errors = last_errors;
     summary.errors       = error_history;
     summary.phi_l1_error = phi_l1_error;
+    if (solid && parameters.solid.particles.size() == 1)
+      {
+        const auto shape    = solid->particle_shape(space, fluid.velocity());
+        summary.deformation = shape.taylor_deformation;
+        summary.inclination = shape.inclination;
+      }
     double h = std::numeric_limits<double>::max();
     for (const auto &cell : triangulation.active_cell_iterators())
       if (cell->is_locally_owned())

@@ -1,19 +1,100 @@
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/convergence_table.h>
+#include <deal.II/base/function_parser.h>
 #include <deal.II/base/mpi.h>
 
 #include <suspension/core/simulation.h>
 #include <suspension/core/study.h>
 
 #include <cmath>
+#include <memory>
 #include <iomanip>
 #include <sstream>
 
 namespace Suspension
 {
+  namespace
+  {
+    /// Runs a simulation; a failure propagates only after the simulation
+    /// (and its TimerOutput) ended normally, so the error stays one line.
+    template <int dim>
+    RunSummary run_one(const Parameters::All &p, MPI_Comm communicator)
+    {
+      RunSummary         r;
+      std::exception_ptr failure;
+      {
+        Simulation<dim> simulation(p, communicator);
+        try
+          {
+            r = simulation.run();
+          }
+        catch (...)
+          {
+            failure = std::current_exception();
+          }
+      }
+      if (failure)
+        std::rethrow_exception(failure);
+      return r;
+    }
+
+    template <int dim>
+    void run_sweep(const Parameters::All &parameters, MPI_Comm communicator)
+    {
+      ConditionalOStream pcout(std::cout, Utilities::MPI::this_mpi_process(communicator) == 0);
+      const auto        &v = parameters.verification;
+      std::vector<std::pair<std::string, RunSummary>> runs;
+      for (const auto &value : v.sweep_values)
+        {
+          pcout << v.sweep_entry << " = " << value << ":" << std::endl;
+          Parameters::All p = Parameters::read(parameters.input_file, dim, {{v.sweep_entry, value}});
+          runs.emplace_back(value, run_one<dim>(p, communicator));
+        }
+      std::unique_ptr<FunctionParser<1>> expected;
+      if (!v.sweep_expected_deformation.empty())
+        {
+          expected = std::make_unique<FunctionParser<1>>(1);
+          expected->initialize("x", v.sweep_expected_deformation, {});
+        }
+      pcout << std::endl << "sweep of " << v.sweep_entry << ":" << std::endl;
+      bool   monotonic_D = true, monotonic_theta = true;
+      double deviation   = 0.;
+      for (unsigned int i = 0; i < runs.size(); ++i)
+        {
+          const auto &[value, r] = runs[i];
+          pcout << "  " << std::setw(10) << value << "  D = " << std::fixed << std::setprecision(4)
+                << r.deformation << "  inclination = " << std::setprecision(2) << r.inclination
+                << " deg";
+          if (expected)
+            {
+              const double e = expected->value(Point<1>(Utilities::string_to_double(value)));
+              deviation      = (r.deformation - e) / e;
+              pcout << "  expected D = " << std::setprecision(4) << e << "  deviation "
+                    << std::setprecision(1) << 100. * deviation << " %";
+            }
+          pcout << std::defaultfloat << std::endl;
+          if (i > 0)
+            {
+              monotonic_D     = monotonic_D && r.deformation > runs[i - 1].second.deformation;
+              monotonic_theta = monotonic_theta && r.inclination < runs[i - 1].second.inclination;
+            }
+        }
+      if (runs.size() > 1)
+        pcout << "  D grows along the sweep: " << (monotonic_D ? "yes" : "no")
+              << ", inclination falls along the sweep: " << (monotonic_theta ? "yes" : "no")
+              << std::endl;
+      if (expected && v.tolerance > 0)
+        pcout << "  |deviation| of the last run <= " << v.tolerance << ": "
+              << (std::abs(deviation) <= v.tolerance ? "yes" : "no") << std::endl;
+    }
+  } // namespace
+
   template <int dim>
   void run_study(const Parameters::All &parameters, MPI_Comm communicator)
   {
+    if (!parameters.verification.sweep_entry.empty())
+      return run_sweep<dim>(parameters, communicator);
+
     ConditionalOStream pcout(std::cout, Utilities::MPI::this_mpi_process(communicator) == 0);
     const auto        &v = parameters.verification;
     const unsigned int cycles = std::max(v.refinement_cycles, v.time_step_cycles);
@@ -29,23 +110,7 @@ namespace Suspension
           p.time_stepping.time_step /= std::pow(2., cycle);
         if (cycles > 1)
           pcout << "cycle " << cycle << ":" << std::endl;
-        RunSummary         r;
-        std::exception_ptr failure;
-        {
-          // Let the simulation (and its TimerOutput) end normally before a
-          // failure propagates, so that the error stays one clear line.
-          Simulation<dim> simulation(p, communicator);
-          try
-            {
-              r = simulation.run();
-            }
-          catch (...)
-            {
-              failure = std::current_exception();
-            }
-        }
-        if (failure)
-          std::rethrow_exception(failure);
+        const RunSummary r = run_one<dim>(p, communicator);
         runs.push_back(r);
       }
     if (cycles == 1)

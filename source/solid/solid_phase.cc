@@ -265,7 +265,7 @@ namespace Suspension::Solid
   void SolidPhase<dim>::reset_B_in_fluid()
   {
     // Pure fluid keeps no memory of deformation: in cells without solid
-    // (phi below 1e-6 at every node) B is set back to I. Otherwise B would
+    // (phi below fluid_threshold at every node) B is set back to I. Otherwise B would
     // grow without bound in sheared fluid (B_11 = 1 + (shear t)^2) and its
     // discretization errors, which the stress G phi (B - I) never sees,
     // would end the run through the SPD check.
@@ -279,7 +279,7 @@ namespace Suspension::Solid
           bool fluid = true;
           for (unsigned int i = 0; i < dofs.size() && fluid; ++i)
             if (fe.system_to_component_index(i).first == 0)
-              fluid = std::abs(solution(dofs[i])) < 1e-6;
+              fluid = std::abs(solution(dofs[i])) < fluid_threshold;
           if (!fluid)
             continue;
           for (unsigned int i = 0; i < dofs.size(); ++i)

@@ -1,3 +1,4 @@
+#include <deal.II/base/mpi.h>
 #include <deal.II/base/symmetric_tensor.h>
 #include <deal.II/fe/mapping_q1.h>
 #include <deal.II/matrix_free/fe_evaluation.h>
@@ -258,9 +259,52 @@ namespace Suspension::Solid
   template <int dim>
   LimiterReport TransportOperator<dim>::limit(VectorType &solution, const bool scale) const
   {
-    LimiterReport                          report;
-    FEEvaluation<dim, -1, 0, 1, double>    phi(matrix_free, 0, 0, 0);
-    for (unsigned int cell = 0; cell < matrix_free.n_cell_batches(); ++cell)
+    LimiterReport                       report;
+    FEEvaluation<dim, -1, 0, 1, double> phi(matrix_free, 0, 0, 0);
+    const unsigned int                  n_batches = matrix_free.n_cell_batches();
+    const unsigned int                  n_lanes   = VectorizedArray<double>::size();
+
+    // Pass 1: cell means and volumes. A mean outside [0, 1] (possible where
+    // the discrete velocity is not divergence-free) cannot be fixed by
+    // scaling within the cell: it is clipped, and the clipped mass is given
+    // back to interface cells in proportion to mean (1 - mean), so that
+    // the total is conserved to round-off.
+    std::vector<double> mean(n_batches * n_lanes, 0.), volume(n_batches * n_lanes, 0.);
+    double              excess = 0., capacity = 0.;
+    for (unsigned int cell = 0; cell < n_batches; ++cell)
+      {
+        phi.reinit(cell);
+        phi.read_dof_values(solution);
+        phi.evaluate(EvaluationFlags::values);
+        for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+          {
+            double integral = 0., vol = 0.;
+            for (const unsigned int q : phi.quadrature_point_indices())
+              {
+                integral += phi.get_value(q)[v] * phi.JxW(q)[v];
+                vol += phi.JxW(q)[v];
+              }
+            const unsigned int k = cell * n_lanes + v;
+            mean[k]   = integral / vol;
+            volume[k] = vol;
+            if (mean[k] < 0. || mean[k] > 1.)
+              {
+                ++report.out_of_bound_means;
+                const double clipped = std::min(1., std::max(0., mean[k]));
+                excess += (mean[k] - clipped) * vol;
+              }
+            else
+              capacity += mean[k] * (1. - mean[k]) * vol;
+          }
+      }
+    const MPI_Comm comm = matrix_free.get_dof_handler(0).get_communicator();
+    excess              = Utilities::MPI::sum(excess, comm);
+    capacity            = Utilities::MPI::sum(capacity, comm);
+    const bool   redistribute = scale && Utilities::MPI::max(report.out_of_bound_means, comm) > 0;
+    const double lambda       = (redistribute && capacity > 0.) ? excess / capacity : 0.;
+
+    // Pass 2: new means, then Zhang-Shu scaling towards them.
+    for (unsigned int cell = 0; cell < n_batches; ++cell)
       {
         phi.reinit(cell);
         phi.read_dof_values(solution);
@@ -268,37 +312,40 @@ namespace Suspension::Solid
         bool changed = false;
         for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
           {
-            double integral = 0., volume = 0., lo = 1e300, hi = -1e300;
+            const unsigned int k        = cell * n_lanes + v;
+            const double       old_mean = mean[k];
+            double             target   = old_mean;
+            if (redistribute)
+              target = (old_mean < 0. || old_mean > 1.) ?
+                         std::min(1., std::max(0., old_mean)) :
+                         old_mean + lambda * old_mean * (1. - old_mean);
+            double lo = 1e300, hi = -1e300;
             for (const unsigned int q : phi.quadrature_point_indices())
               {
-                const double value = phi.get_value(q)[v];
-                integral += value * phi.JxW(q)[v];
-                volume += phi.JxW(q)[v];
-                lo = std::min(lo, value);
-                hi = std::max(hi, value);
+                lo = std::min(lo, phi.get_value(q)[v] - old_mean + target);
+                hi = std::max(hi, phi.get_value(q)[v] - old_mean + target);
               }
             for (unsigned int i = 0; i < phi.dofs_per_cell; ++i)
               {
-                lo = std::min(lo, phi.begin_dof_values()[i][v]);
-                hi = std::max(hi, phi.begin_dof_values()[i][v]);
+                lo = std::min(lo, phi.begin_dof_values()[i][v] - old_mean + target);
+                hi = std::max(hi, phi.begin_dof_values()[i][v] - old_mean + target);
               }
-            const double mean = integral / volume;
-            if (mean < 0. || mean > 1.)
-              ++report.out_of_bound_means;
+            // the mean of a Lagrange field moves by adding a constant
             double theta = 1.;
-            if (hi > 1. && hi > mean)
-              theta = std::min(theta, std::max(0., 1. - mean) / (hi - mean));
-            if (lo < 0. && lo < mean)
-              theta = std::min(theta, std::max(0., mean) / (mean - lo));
-            if (scale && theta < 1.)
+            if (hi > 1. && hi > target)
+              theta = std::min(theta, std::max(0., 1. - target) / (hi - target));
+            if (lo < 0. && lo < target)
+              theta = std::min(theta, std::max(0., target) / (target - lo));
+            if (scale && (theta < 1. || target != old_mean))
               {
-                ++report.limited_cells;
+                if (theta < 1.)
+                  ++report.limited_cells;
                 changed = true;
                 for (unsigned int i = 0; i < phi.dofs_per_cell; ++i)
                   phi.begin_dof_values()[i][v] =
-                    mean + theta * (phi.begin_dof_values()[i][v] - mean);
-                lo = mean + theta * (lo - mean);
-                hi = mean + theta * (hi - mean);
+                    target + theta * (phi.begin_dof_values()[i][v] - old_mean);
+                lo = target + theta * (lo - target);
+                hi = target + theta * (hi - target);
               }
             report.min_phi = std::min(report.min_phi, lo);
             report.max_phi = std::max(report.max_phi, hi);

@@ -250,6 +250,10 @@ namespace Suspension::Parameters
     double              tolerance         = 0.;
     double              minimum_velocity_rate = 0.;
     double              minimum_pressure_rate = 0.;
+    // a sweep over one entry, e.g. "Solid/Shear modulus"
+    std::string         sweep_entry;
+    std::vector<std::string> sweep_values;
+    std::string         sweep_expected_deformation; // function of x = value
 
     static void declare(ParameterHandler &prm, unsigned int dim);
     void        parse(ParameterHandler &prm, unsigned int dim);
@@ -281,7 +285,8 @@ namespace Suspension::Parameters
 
   /// Declares, reads and checks the whole file for the given dimension.
   /// Throws InputError (or a deal.II exception from ParameterHandler).
-  All read(const std::string &filename, unsigned int dim);
+  All read(const std::string &filename, unsigned int dim,
+           const std::vector<std::pair<std::string, std::string>> &overrides = {});
 
   /// Variable names for function expressions: "x,y,t" or "x,y,z,t".
   std::string variable_names(unsigned int dim);

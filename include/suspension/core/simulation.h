@@ -24,6 +24,7 @@ namespace Suspension
   {
     Postprocess::FlowErrors final_errors;
     double                  phi_l1_error = -1.; // < 0: not computed
+    double                  deformation = 0., inclination = 0.; // one particle
     /// errors at the report times and at the end, in time order
     std::vector<std::pair<double, Postprocess::FlowErrors>> errors;
     double                  smallest_cell = 0.;

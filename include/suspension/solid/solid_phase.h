@@ -99,7 +99,9 @@ namespace Suspension::Solid
     void reset_B_in_fluid();
 
     /// B is checked (SPD) where phi is at least this.
-    static constexpr double solid_threshold = 1e-3;
+    static constexpr double solid_threshold = 0.1;
+    /// B is reset to I in cells where phi is below this at every node.
+    static constexpr double fluid_threshold = 1e-4;
     void copy_velocity(const Fluid::VectorType &in, VectorType &out) const;
 
     const Parameters::All &parameters;
