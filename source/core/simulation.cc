@@ -1,5 +1,6 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/utilities.h>
+#include <deal.II/lac/solver_control.h>
 
 #include <suspension/core/simulation.h>
 #include <suspension/fluid/body_force.h>
@@ -447,11 +448,33 @@ namespace Suspension
             if (solid)
               {
                 TimerOutput::Scope scope(timer, "solid transport");
-                solid_diagnostics = solid->advance(dt, diagnostics.max_speed_over_h,
-                                                   fluid.velocity(),
-                                                   fluid.extrapolated_velocity(dt));
+                try
+                  {
+                    solid_diagnostics = solid->advance(dt, diagnostics.max_speed_over_h,
+                                                       fluid.velocity(),
+                                                       fluid.extrapolated_velocity(dt));
+                  }
+                catch (...)
+                  {
+                    // the state that failed the checks, for a look in ParaView
+                    write_output();
+                    write_tables();
+                    throw;
+                  }
               }
-            report = fluid.advance(dt, sources);
+            try
+              {
+                report = fluid.advance(dt, sources);
+              }
+            catch (const SolverControl::NoConvergence &e)
+              {
+                write_output();
+                write_tables();
+                throw std::runtime_error(
+                  "a linear solver of the fluid step diverged at t = " +
+                  std::to_string(fluid.time() + dt) + " (residual " + std::to_string(e.last_residual) +
+                  "); reduce the time step or the CFL number; the last state was written");
+              }
           }
         {
           TimerOutput::Scope scope(timer, "diagnostics");

@@ -214,8 +214,10 @@ namespace Suspension::Solid
   {
     SolidDiagnostics d;
     const QGauss<dim>  quadrature(fe.degree + 2);
-    FEValues<dim>      fe_values(fe, quadrature, update_values | update_JxW_values);
+    FEValues<dim>      fe_values(fe, quadrature,
+                            update_values | update_JxW_values | update_quadrature_points);
     const unsigned int nc = fe.n_components();
+    Point<dim>         worst;
     std::vector<Vector<double>> values(quadrature.size(), Vector<double>(nc));
     double volume = 0., lo = 1e300, hi = -1e300, det_min = 1e300, eig_min = 1e300;
     std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
@@ -236,7 +238,12 @@ namespace Suspension::Solid
                   for (unsigned int c = 0; c < n_B; ++c)
                     B[SymmetricTensor<2, dim>::unrolled_to_component_indices(c)] = values[q][1 + c];
                   det_min = std::min(det_min, determinant(B));
-                  eig_min = std::min(eig_min, eigenvalues(B)[dim - 1]);
+                  const double smallest = eigenvalues(B)[dim - 1];
+                  if (smallest < eig_min || !std::isfinite(smallest))
+                    {
+                      eig_min = smallest;
+                      worst   = fe_values.quadrature_point(q);
+                    }
                 }
             }
           // nodal values too: the limiter's bounds hold there as well
@@ -255,8 +262,12 @@ namespace Suspension::Solid
     d.max_phi      = Utilities::MPI::max(hi, comm);
     if (nc > 1)
       {
-        d.min_det_B        = Utilities::MPI::min(det_min, comm);
-        d.min_eigenvalue_B = Utilities::MPI::min(eig_min, comm);
+        d.min_det_B = Utilities::MPI::min(det_min, comm);
+        const auto m = Utilities::MPI::min_max_avg(eig_min, comm);
+        d.min_eigenvalue_B = m.min;
+        const Point<dim> where = Utilities::MPI::broadcast(comm, worst, m.min_index);
+        for (unsigned int c = 0; c < dim; ++c)
+          d.worst_B_location[c] = where[c];
       }
     return d;
   }
@@ -300,8 +311,12 @@ namespace Suspension::Solid
       {
         std::ostringstream message;
         message << "the left Cauchy-Green tensor B is no longer symmetric positive definite at t = "
-                << t << " (smallest eigenvalue " << d.min_eigenvalue_B
-                << "); reduce the time step ('Solid/Elastic number', 'Time stepping/CFL number')";
+                << t << " at (" << d.worst_B_location[0];
+        for (unsigned int c = 1; c < dim; ++c)
+          message << ", " << d.worst_B_location[c];
+        message << ") (smallest eigenvalue " << d.min_eigenvalue_B
+                << "); reduce the time step ('Solid/Elastic number', 'Time stepping/CFL "
+                   "number') or refine the mesh; the last state was written";
         throw std::runtime_error(message.str());
       }
   }

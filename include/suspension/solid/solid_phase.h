@@ -12,6 +12,7 @@
 #include <suspension/fluid/momentum_source.h>
 #include <suspension/solid/transport_operator.h>
 
+#include <array>
 #include <memory>
 
 namespace Suspension::Solid
@@ -23,6 +24,7 @@ namespace Suspension::Solid
     double       min_phi = 0., max_phi = 0.;
     unsigned int limited_cells = 0, out_of_bound_means = 0, substeps = 0;
     double       min_det_B = 1., min_eigenvalue_B = 1.;
+    std::array<double, 3> worst_B_location{}; // where min_eigenvalue_B is
   };
 
   /// Shape of one particle from the moments of phi.
