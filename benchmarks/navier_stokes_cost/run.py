@@ -15,11 +15,26 @@ import csv
 import math
 import os
 import re
+import resource
 import shutil
 import statistics
 import subprocess
 import sys
 import time
+
+# matplotlib comes from Debian (python3-matplotlib), i.e. /usr/bin/python3;
+# a 'python3' earlier in PATH (pyenv, venv) may lack it: re-run with Debian's.
+try:
+    import matplotlib
+except ImportError:
+    if os.path.realpath(sys.executable) != os.path.realpath("/usr/bin/python3") \
+            and os.path.exists("/usr/bin/python3"):
+        os.execv("/usr/bin/python3", ["/usr/bin/python3"] + sys.argv)
+    subprocess.run(["apt-get", "install", "-y", "python3-matplotlib"], check=True,
+                   env=dict(os.environ, DEBIAN_FRONTEND="noninteractive"))
+    import matplotlib
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
 
 T_START = time.perf_counter()
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -49,6 +64,8 @@ DEGREE = 2      # Q2 velocity
 
 LOAD_LIMIT = 0.7
 LOAD_MAX_WAIT = 120.0
+FOREIGN_LIMIT = 0.25    # cores used by other processes that make a run suspect
+RETRY_DEADLINE = 600.0  # no repeated runs after this much script time
 
 ENV = dict(os.environ,
            OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
@@ -99,12 +116,45 @@ def wait_for_quiet(label):
     return load1() - own_residual_load()
 
 
-def finished_run(ranks, t0):
-    """Record a timed run; return the load average in excess of our own ranks."""
+def cpu_counters():
+    """(CPU seconds used by everything on the machine, by us and our children)."""
+    with open("/proc/stat") as f:
+        v = [int(x) for x in f.readline().split()[1:]]
+    busy = v[0] + v[1] + v[2] + v[5] + v[6] + (v[7] if len(v) > 7 else 0)
+    own = sum(getattr(resource.getrusage(w), a) for w in
+              (resource.RUSAGE_SELF, resource.RUSAGE_CHILDREN) for a in ("ru_utime", "ru_stime"))
+    return busy / os.sysconf("SC_CLK_TCK"), own
+
+
+def finished_run(ranks, t0, counters0):
+    """Record a timed run; return the mean number of cores busy with other
+    processes during it (from /proc/stat less our own CPU time)."""
     global LAST_RUN
     now = time.perf_counter()
     LAST_RUN = (ranks, now - t0, now)
-    return load1() - own_residual_load()
+    busy1, own1 = cpu_counters()
+    return max(0.0, ((busy1 - counters0[0]) - (own1 - counters0[1])) / (now - t0))
+
+
+def measure(label, fn, *args):
+    """Run fn; if other processes used more than FOREIGN_LIMIT cores during
+    it, repeat once (while the retry budget lasts) and keep the faster."""
+    best = None
+    for attempt in range(2):
+        r = fn(*args)
+        r["attempts"] = attempt + 1
+        if best is None or r["sec_per_step"] < best["sec_per_step"]:
+            best = dict(r, attempts=attempt + 1)
+        if r["foreign_cpu"] <= FOREIGN_LIMIT:
+            break
+        if time.perf_counter() - T_START > RETRY_DEADLINE:
+            break
+        log(f"{label}: other processes used {r['foreign_cpu']:.2f} cores during the run; "
+            f"repeating it")
+    if best["foreign_cpu"] > FOREIGN_LIMIT:
+        notes.append(f"{label}: other processes used {best['foreign_cpu']:.2f} cores "
+                     f"during the kept run")
+    return best
 
 
 # ---------------------------------------------------------------- step-35
@@ -177,6 +227,7 @@ def run_step35(build, exe, refines, n_measured):
     open(os.path.join(run_dir, "parameter-file.prm"), "w").write(prm)
 
     load_before = wait_for_quiet(f"step-35 r={refines}")
+    counters0 = cpu_counters()
     t0 = time.perf_counter()
     proc = subprocess.Popen([exe], cwd=run_dir, env=ENV, stdout=subprocess.PIPE,
                             stderr=subprocess.STDOUT, text=True, bufsize=1)
@@ -189,7 +240,7 @@ def run_step35(build, exe, refines, n_measured):
             stamps[int(m.group(1))] = now
     proc.wait()
     total = time.perf_counter() - t0
-    load_after = finished_run(1, t0)
+    foreign = finished_run(1, t0, counters0)
     text = "".join(out)
     open(os.path.join(run_dir, "output.log"), "w").write(text)
     if proc.returncode != 0 or "Apparently everything went fine" not in text:
@@ -202,7 +253,7 @@ def run_step35(build, exe, refines, n_measured):
                 dt=dt, steps=n_measured, sec_per_step=(stamps[last] - stamps[first]) / n_measured,
                 sec_min=min(per_step), sec_max=max(per_step),
                 setup_s=stamps[first] - t0, total_s=total, cfl="", its="",
-                load_before=load_before, load_after=load_after)
+                load_before=load_before, foreign_cpu=foreign)
 
 
 # ---------------------------------------------------------------- ours
@@ -283,10 +334,11 @@ def run_ours(dim, refines, ranks, n_measured):
     if ranks > 1:
         cmd = ["mpirun", "-np", str(ranks)] + cmd
     load_before = wait_for_quiet(name)
+    counters0 = cpu_counters()
     t0 = time.perf_counter()
     res = subprocess.run(cmd, env=ENV, capture_output=True, text=True, cwd=WORK)
     total = time.perf_counter() - t0
-    load_after = finished_run(ranks, t0)
+    foreign = finished_run(ranks, t0, counters0)
     open(os.path.join(out_dir, "output.log"), "w").write(res.stdout + res.stderr)
     if res.returncode != 0:
         sys.exit(f"error: {name} failed (exit {res.returncode}), see {out_dir}/output.log")
@@ -309,7 +361,7 @@ def run_ours(dim, refines, ranks, n_measured):
                 sec_mean=statistics.fmean(wt_meas), sec_min=min(wt_meas), sec_max=max(wt_meas),
                 setup_s=total - sum(wt), first_steps_s=sum(wt[:OURS_SKIP]), total_s=total,
                 cfl=f"{max(r[cols['CFL']] for r in meas):.3f}", its=its,
-                its_range=its_range, load_before=load_before, load_after=load_after)
+                its_range=its_range, load_before=load_before, foreign_cpu=foreign)
 
 
 # ---------------------------------------------------------------- analysis
@@ -349,17 +401,17 @@ def main():
 
     results = []
     for refines, n in STEP35_CASES:
-        r = run_step35(build, exe, refines, n)
+        r = measure(f"step-35 r={refines}", run_step35, build, exe, refines, n)
         log(f"step-35 r={refines}: {r['dofs']} DoFs, {r['sec_per_step']:.4f} s/step "
-            f"(setup {r['setup_s']:.1f} s), foreign load {r['load_before']:.2f} -> {r['load_after']:.2f}")
+            f"(setup {r['setup_s']:.1f} s), load before {r['load_before']:.2f}, foreign CPU {r['foreign_cpu']:.2f}")
         results.append(r)
     for dim, refines, n in OURS_CASES:
         for ranks in RANKS:
-            r = run_ours(dim, refines, ranks, n)
+            r = measure(f"ours {dim}D r={refines} np={ranks}", run_ours, dim, refines, ranks, n)
             log(f"ours {dim}D r={refines} np={ranks}: {r['dofs']} DoFs, "
                 f"{r['sec_per_step']:.4f} s/step (mean {r['sec_mean']:.4f}), its {r['its']}, "
-                f"CFL {r['cfl']}, run {r['total_s']:.1f} s, foreign load "
-                f"{r['load_before']:.2f} -> {r['load_after']:.2f}")
+                f"CFL {r['cfl']}, run {r['total_s']:.1f} s, load before "
+                f"{r['load_before']:.2f}, foreign CPU {r['foreign_cpu']:.2f}")
             results.append(r)
 
     for r in results:
@@ -390,7 +442,7 @@ def main():
                        f"{ours2[rk][-1]['dofs']} DoFs, {rk} rank(s): {g:.2f}x "
                        f"(target <= 1.5x: {'met' if g <= 1.5 else 'NOT met'})")
     worst = max(r["ratio"] for r in ours2[1])
-    summary.append(f"ours (1 rank) / step-35 cost per DoF: "
+    summary.append("ours (1 rank) / step-35 cost per DoF: "
                    + ", ".join(f"{r['ratio']:.2f}" for r in ours2[1])
                    + f"; worst {worst:.2f} (target <= 0.33: "
                    + f"{'met' if worst <= 1 / 3 else 'NOT met'})")
@@ -399,7 +451,7 @@ def main():
     fields = ["code", "dim", "ranks", "refinements", "dofs", "dt", "cfl", "steps",
               "sec_per_step", "us_per_step_per_dof", "ratio_to_step35", "sec_min", "sec_max",
               "sec_mean", "setup_s", "total_s", "median_its_mom_proj_mass",
-              "foreign_load_before", "foreign_load_after"]
+              "load_before", "foreign_cpu_cores", "attempts"]
     with open(os.path.join(HERE, "results.csv"), "w", newline="") as f:
         w = csv.writer(f)
         w.writerow(fields)
@@ -411,12 +463,9 @@ def main():
                         f"{r['sec_min']:.6g}", f"{r['sec_max']:.6g}",
                         f"{r.get('sec_mean', r['sec_per_step']):.6g}",
                         f"{r['setup_s']:.3g}", f"{r['total_s']:.3g}", r["its"],
-                        f"{r['load_before']:.2f}", f"{r['load_after']:.2f}"])
+                        f"{r['load_before']:.2f}", f"{r['foreign_cpu']:.2f}", r["attempts"]])
 
     # ---- plot
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
     fig, ax = plt.subplots(figsize=(7, 4.5))
     series = [("step-35 (deal.II tutorial, 2D, serial)", "step-35", 2, 1, "k", "s-")]
     series += [(f"ours {d}D, {rk} rank{'s' if rk > 1 else ''}", "ours", d, rk,

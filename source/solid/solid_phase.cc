@@ -171,6 +171,8 @@ namespace Suspension::Solid
     const auto    limit = [&](VectorType &v) {
       v.zero_out_ghost_values();
       r = transport.limit(v, scale);
+      if (scale)
+        r.limited_cells += transport.limit_B(v);
       report.limited_cells += r.limited_cells;
       report.out_of_bound_means += r.out_of_bound_means;
     };

@@ -356,6 +356,73 @@ namespace Suspension::Solid
     return report;
   }
 
+  template <int dim>
+  unsigned int TransportOperator<dim>::limit_B(VectorType &solution) const
+  {
+    if (!with_B)
+      return 0;
+    unsigned int                          n_limited = 0;
+    FEEvaluation<dim, -1, 0, n_B, double> b(matrix_free, 0, 0, 1);
+    const auto smallest = [](const Tensor<1, n_B, VA> &t, const unsigned int v) {
+      SymmetricTensor<2, dim> B;
+      for (unsigned int c = 0; c < n_B; ++c)
+        B[SymmetricTensor<2, dim>::unrolled_to_component_indices(c)] = t[c][v];
+      return eigenvalues(B)[dim - 1];
+    };
+    for (unsigned int cell = 0; cell < matrix_free.n_cell_batches(); ++cell)
+      {
+        b.reinit(cell);
+        b.read_dof_values(solution);
+        b.evaluate(EvaluationFlags::values);
+        bool changed = false;
+        for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+          {
+            Tensor<1, n_B, VA> mean;
+            double             volume = 0.;
+            for (const unsigned int q : b.quadrature_point_indices())
+              {
+                mean += b.get_value(q) * b.JxW(q)[v];
+                volume += b.JxW(q)[v];
+              }
+            mean /= volume;
+            const double lambda_mean = smallest(mean, v);
+            if (!(lambda_mean > 0.))
+              continue; // nothing a scaling can do; the SPD check reports it
+            // keep at least a tenth of the mean's smallest eigenvalue
+            const double floor = 0.1 * lambda_mean;
+            double       theta = 1.;
+            const auto   consider = [&](const double lambda) {
+              if (lambda < floor)
+                theta = std::min(theta, (lambda_mean - floor) / (lambda_mean - lambda));
+            };
+            for (const unsigned int q : b.quadrature_point_indices())
+              consider(smallest(b.get_value(q), v));
+            const unsigned int n_nodes = b.dofs_per_component;
+            for (unsigned int i = 0; i < n_nodes; ++i)
+              {
+                Tensor<1, n_B, VA> node;
+                for (unsigned int c = 0; c < n_B; ++c)
+                  node[c] = b.begin_dof_values()[c * n_nodes + i];
+                consider(smallest(node, v));
+              }
+            if (theta < 1.)
+              {
+                ++n_limited;
+                changed = true;
+                for (unsigned int c = 0; c < n_B; ++c)
+                  for (unsigned int i = 0; i < n_nodes; ++i)
+                    {
+                      auto &value = b.begin_dof_values()[c * n_nodes + i][v];
+                      value       = mean[c][v] + theta * (value - mean[c][v]);
+                    }
+              }
+          }
+        if (changed)
+          b.set_dof_values(solution);
+      }
+    return n_limited;
+  }
+
   template class TransportOperator<2>;
   template class TransportOperator<3>;
 } // namespace Suspension::Solid

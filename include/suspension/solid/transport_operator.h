@@ -58,6 +58,13 @@ namespace Suspension::Solid
     /// at the nodes and quadrature points; means are left unchanged.
     LimiterReport limit(VectorType &solution, bool scale) const;
 
+    /// Scaling of B towards its cell mean so that its smallest eigenvalue
+    /// stays positive at the nodes and quadrature points (the smallest
+    /// eigenvalue of an affine matrix function is concave, so one scaling
+    /// factor per cell suffices); cell means are unchanged. Returns the
+    /// number of cells scaled.
+    unsigned int limit_B(VectorType &solution) const;
+
     const MatrixFree<dim, double> &get_matrix_free() const { return matrix_free; }
 
   private:
