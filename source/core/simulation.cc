@@ -111,6 +111,12 @@ namespace Suspension
       next = std::min(next, parameters.solid.elastic_number * smallest_cell() /
                               std::sqrt(parameters.solid.shear_modulus /
                                         parameters.material.density));
+    // A collapsing step means the flow blew up without (yet) a NaN.
+    if (next < 1e-6 * ts.time_step)
+      throw std::runtime_error(
+        "the time step collapsed to " + std::to_string(next) + " at t = " + std::to_string(time) +
+        " (kinetic energy " + std::to_string(d.kinetic_energy) +
+        "): the flow is unstable; reduce 'Time stepping/CFL number' or 'Solid/Elastic number'");
     // Land exactly on report times and on the end time.
     std::vector<double> targets = parameters.verification.report_times;
     targets.push_back(ts.end_time);
@@ -429,7 +435,16 @@ namespace Suspension
            (ts.maximum_steps == 0 || fluid.step_number() < ts.maximum_steps))
       {
         const auto step_start = std::chrono::steady_clock::now();
-        dt = choose_time_step(dt, fluid.time(), diagnostics);
+        try
+          {
+            dt = choose_time_step(dt, fluid.time(), diagnostics);
+          }
+        catch (...)
+          {
+            write_output();
+            write_tables();
+            throw;
+          }
 
         Fluid::StepReport report;
         if (prescribed_velocity)
