@@ -80,6 +80,7 @@ namespace Suspension
     fluid.initialize(prescribed_velocity.get());
     if (solid)
       solid->setup(space);
+    smallest_cell_size = smallest_cell();
   }
 
   template <int dim>
@@ -108,7 +109,7 @@ namespace Suspension
       }
     // The explicit elastic stress: an elastic wave may not cross a cell.
     if (solid && parameters.solid.elastic() && !prescribed_velocity)
-      next = std::min(next, parameters.solid.elastic_number * smallest_cell() /
+      next = std::min(next, parameters.solid.elastic_number * smallest_cell_size /
                               std::sqrt(parameters.solid.shear_modulus /
                                         parameters.material.density));
     // A collapsing step means the flow blew up without (yet) a NaN.

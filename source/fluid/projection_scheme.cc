@@ -158,8 +158,13 @@ namespace Suspension::Fluid
     }
 
     // 1. momentum predictor
+    // Boundary data only need rebuilding when a face carries a (possibly
+    // time-dependent) non-zero velocity; otherwise the homogeneous
+    // constraints of the space are the step's constraints.
     scene.set_time(t_new);
-    space.make_velocity_constraints(scene, false, step_constraints);
+    if (scene.has_inhomogeneous_velocity() || n_steps == 0)
+      space.make_velocity_constraints(scene, !scene.has_inhomogeneous_velocity(),
+                                      step_constraints);
     assemble_momentum_rhs(dt, t_new, sources);
     section.next("fluid: momentum solve");
     report.momentum_iterations =

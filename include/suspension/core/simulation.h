@@ -81,6 +81,7 @@ namespace Suspension
     Postprocess::FlowErrors                   last_errors;
     std::vector<std::pair<double, Postprocess::FlowErrors>> error_history;
     std::vector<std::string>                  last_probe_values;
+    double                                    smallest_cell_size = 0.; // per mesh
     double                                    last_output_time   = 0.;
     double                                    last_driving_force = 0.;
   };
