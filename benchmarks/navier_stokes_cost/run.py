@@ -35,6 +35,7 @@ except ImportError:
     import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
+import matplotlib.ticker  # noqa: E402
 
 T_START = time.perf_counter()
 HERE = os.path.dirname(os.path.abspath(__file__))
@@ -113,7 +114,7 @@ def wait_for_quiet(label):
     waited = time.perf_counter() - t0
     if waited > 1:
         log(f"waited {waited:.0f} s for quiet load")
-    return load1() - own_residual_load()
+    return max(0.0, load1() - own_residual_load())
 
 
 def cpu_counters():
@@ -477,6 +478,11 @@ def main():
             ax.plot(*zip(*pts), style, color=color, label=label)
     ax.set_xscale("log")
     ax.set_yscale("log")
+    ax.set_yticks([t for t in (0.5, 1, 2, 5, 10, 20, 50, 100, 200)
+                   if min(r["us_per_dof"] for r in results) / 2 < t
+                   < max(r["us_per_dof"] for r in results) * 2])
+    ax.yaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
+    ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
     ax.set_xlabel("DoFs (velocity + pressure)")
     ax.set_ylabel("wall time per step per DoF [µs]")
     ax.set_title("Navier–Stokes projection step cost (Q2/Q1)")
