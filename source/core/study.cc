@@ -126,17 +126,18 @@ namespace Suspension
         largest_pressure_error = std::max(largest_pressure_error, e.pressure_l2);
     const bool     with_pressure = largest_pressure_error > 1e-10;
     const bool     with_phi      = runs.front().phi_l1_error >= 0.;
-    ConvergenceTable table;
-    std::vector<std::string> columns;
+    ConvergenceTable         table;
+    std::vector<std::string> columns; // error columns, in the order of the first run
     for (const auto &r : runs)
       {
+        const auto add = [&](const std::string &name, const double value) {
+          table.add_value(name, value);
+          if (&r == &runs.front())
+            columns.push_back(name);
+        };
         table.add_value(key, in_space ? r.smallest_cell : r.time_step);
         if (with_phi)
-          {
-            table.add_value("phi L1", r.phi_l1_error);
-            if (&r == &runs.front())
-              columns.push_back("phi L1");
-          }
+          add("phi L1", r.phi_l1_error);
         for (unsigned int k = 0; k < r.errors.size() && k < reported.size(); ++k)
           {
             // the last entry is the end of the run (possibly a steady state
@@ -146,17 +147,9 @@ namespace Suspension
               t << "final";
             else
               t << std::setprecision(6) << "t=" << reported[k].first;
-            table.add_value("u L2 " + t.str(), r.errors[k].second.velocity_l2);
-            if (k == 0 && &r == &runs.front())
-              columns.push_back("u L2 " + t.str());
+            add("u L2 " + t.str(), r.errors[k].second.velocity_l2);
             if (with_pressure)
-              {
-                table.add_value("p L2 " + t.str(), r.errors[k].second.pressure_l2);
-                if (&r == &runs.front())
-                  columns.push_back("p L2 " + t.str());
-              }
-            if (k > 0 && &r == &runs.front())
-              columns.push_back("u L2 " + t.str());
+              add("p L2 " + t.str(), r.errors[k].second.pressure_l2);
           }
       }
     table.set_scientific(key, true);
