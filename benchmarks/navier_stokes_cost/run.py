@@ -3,8 +3,9 @@
 
 Usage (from the repository root):
 
-    python3 benchmarks/navier_stokes_cost/run.py
+    python3 benchmarks/navier_stokes_cost/run.py [--replot]
 
+(--replot only redraws the chart and reprints the table from results.csv.)
 Builds deal.II's step-35 tutorial (unchanged, Release) in work/, runs it at
 three refinement levels and our solver (build/suspension, not rebuilt) on a
 2D channel at three sizes on 1 and 2 MPI ranks plus one 3D channel, and
@@ -378,6 +379,78 @@ def step35_cost_at(ref, dofs):
     return math.exp(y0 + (y1 - y0) * (x - x0) / (x1 - x0))
 
 
+def table_and_summary(results):
+    """Markdown table and the two target figures."""
+    header = ["code", "dim", "ranks", "DoFs", "steps measured", "s/step",
+              "us/step/DoF", "ours/step-35"]
+    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
+    for r in results:
+        lines.append("| " + " | ".join([
+            r["code"], str(r["dim"]), str(r["ranks"]), str(r["dofs"]), str(r["steps"]),
+            f"{r['sec_per_step']:.4f}", f"{r['us_per_dof']:.2f}",
+            f"{r['ratio']:.2f}" if r["ratio"] != "" else "-"]) + " |")
+    table = "\n".join(lines)
+
+    ours2 = {rk: sorted((r for r in results if r["code"] == "ours" and r["dim"] == 2
+                         and r["ranks"] == rk), key=lambda r: r["dofs"]) for rk in RANKS}
+    summary = []
+    for rk in RANKS:
+        g = ours2[rk][-1]["us_per_dof"] / ours2[rk][0]["us_per_dof"]
+        summary.append(f"growth of our 2D cost per DoF, {ours2[rk][0]['dofs']} -> "
+                       f"{ours2[rk][-1]['dofs']} DoFs, {rk} rank(s): {g:.2f}x "
+                       f"(target <= 1.5x: {'met' if g <= 1.5 else 'NOT met'})")
+    worst = max(r["ratio"] for r in ours2[1])
+    summary.append("ours (1 rank) / step-35 cost per DoF: "
+                   + ", ".join(f"{r['ratio']:.2f}" for r in ours2[1])
+                   + f"; worst {worst:.2f} (target <= 0.33: "
+                   + f"{'met' if worst <= 1 / 3 else 'NOT met'})")
+    return table, summary
+
+
+def plot(results):
+    """cost_per_dof.png"""
+    fig, ax = plt.subplots(figsize=(7, 4.5))
+    series = [("step-35 (deal.II tutorial, 2D, serial)", "step-35", 2, 1, "k", "s-")]
+    series += [(f"ours {d}D, {rk} rank{'s' if rk > 1 else ''}", "ours", d, rk,
+                c, m) for d, c in ((2, "C0"), (3, "C3")) for rk, m in ((1, "o-"), (2, "^--"))]
+    for label, code, d, rk, color, style in series:
+        pts = sorted((r["dofs"], r["us_per_dof"]) for r in results
+                     if r["code"] == code and r["dim"] == d and r["ranks"] == rk)
+        if pts:
+            ax.plot(*zip(*pts), style, color=color, label=label)
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_yticks([t for t in (0.5, 1, 2, 5, 10, 20, 50, 100, 200)
+                   if min(r["us_per_dof"] for r in results) / 2 < t
+                   < max(r["us_per_dof"] for r in results) * 2])
+    ax.yaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
+    ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
+    ax.set_xlabel("DoFs (velocity + pressure)")
+    ax.set_ylabel("wall time per step per DoF [µs]")
+    ax.set_title("Navier–Stokes projection step cost (Q2/Q1)")
+    ax.grid(True, which="both", alpha=0.3)
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(os.path.join(HERE, "cost_per_dof.png"), dpi=120)
+
+
+def replot():
+    """--replot: table, targets and chart again from results.csv, no runs."""
+    results = []
+    with open(os.path.join(HERE, "results.csv")) as f:
+        rows = list(csv.DictReader(line for line in f if not line.startswith("#")))
+    for row in rows:
+        ratio = row["ratio_to_step35"]
+        results.append(dict(code=row["code"], dim=int(row["dim"]), ranks=int(row["ranks"]),
+                            dofs=int(row["dofs"]), steps=int(row["steps"]),
+                            sec_per_step=float(row["sec_per_step"]),
+                            us_per_dof=float(row["us_per_step_per_dof"]),
+                            ratio=float(ratio) if ratio else ""))
+    table, summary = table_and_summary(results)
+    plot(results)
+    print(table + "\n\n" + "\n".join(summary))
+
+
 def snapshot_suspension():
     exe = os.path.join(BUILD, "suspension")
     lib = os.path.join(BUILD, "libsuspension_lib.so")
@@ -393,6 +466,8 @@ def snapshot_suspension():
 
 
 def main():
+    if "--replot" in sys.argv[1:]:
+        return replot()
     os.makedirs(WORK, exist_ok=True)
     snapshot_suspension()
     log(f"load average at start: {load1():.2f}")
@@ -423,30 +498,7 @@ def main():
         if r["code"] == "ours" and r["dim"] == 2:
             r["ratio"] = r["us_per_dof"] / step35_cost_at(ref, r["dofs"])
 
-    # ---- table
-    header = ["code", "dim", "ranks", "DoFs", "steps measured", "s/step",
-              "us/step/DoF", "ours/step-35"]
-    lines = ["| " + " | ".join(header) + " |", "|" + "---|" * len(header)]
-    for r in results:
-        lines.append("| " + " | ".join([
-            r["code"], str(r["dim"]), str(r["ranks"]), str(r["dofs"]), str(r["steps"]),
-            f"{r['sec_per_step']:.4f}", f"{r['us_per_dof']:.2f}",
-            f"{r['ratio']:.2f}" if r["ratio"] != "" else "-"]) + " |")
-    table = "\n".join(lines)
-
-    ours2 = {rk: sorted((r for r in results if r["code"] == "ours" and r["dim"] == 2
-                         and r["ranks"] == rk), key=lambda r: r["dofs"]) for rk in RANKS}
-    summary = []
-    for rk in RANKS:
-        g = ours2[rk][-1]["us_per_dof"] / ours2[rk][0]["us_per_dof"]
-        summary.append(f"growth of our 2D cost per DoF, {ours2[rk][0]['dofs']} -> "
-                       f"{ours2[rk][-1]['dofs']} DoFs, {rk} rank(s): {g:.2f}x "
-                       f"(target <= 1.5x: {'met' if g <= 1.5 else 'NOT met'})")
-    worst = max(r["ratio"] for r in ours2[1])
-    summary.append("ours (1 rank) / step-35 cost per DoF: "
-                   + ", ".join(f"{r['ratio']:.2f}" for r in ours2[1])
-                   + f"; worst {worst:.2f} (target <= 0.33: "
-                   + f"{'met' if worst <= 1 / 3 else 'NOT met'})")
+    table, summary = table_and_summary(results)
 
     # ---- csv
     fields = ["code", "dim", "ranks", "refinements", "dofs", "dt", "cfl", "steps",
@@ -466,30 +518,7 @@ def main():
                         f"{r['setup_s']:.3g}", f"{r['total_s']:.3g}", r["its"],
                         f"{r['load_before']:.2f}", f"{r['foreign_cpu']:.2f}", r["attempts"]])
 
-    # ---- plot
-    fig, ax = plt.subplots(figsize=(7, 4.5))
-    series = [("step-35 (deal.II tutorial, 2D, serial)", "step-35", 2, 1, "k", "s-")]
-    series += [(f"ours {d}D, {rk} rank{'s' if rk > 1 else ''}", "ours", d, rk,
-                c, m) for d, c in ((2, "C0"), (3, "C3")) for rk, m in ((1, "o-"), (2, "^--"))]
-    for label, code, d, rk, color, style in series:
-        pts = sorted((r["dofs"], r["us_per_dof"]) for r in results
-                     if r["code"] == code and r["dim"] == d and r["ranks"] == rk)
-        if pts:
-            ax.plot(*zip(*pts), style, color=color, label=label)
-    ax.set_xscale("log")
-    ax.set_yscale("log")
-    ax.set_yticks([t for t in (0.5, 1, 2, 5, 10, 20, 50, 100, 200)
-                   if min(r["us_per_dof"] for r in results) / 2 < t
-                   < max(r["us_per_dof"] for r in results) * 2])
-    ax.yaxis.set_major_formatter(matplotlib.ticker.ScalarFormatter())
-    ax.yaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
-    ax.set_xlabel("DoFs (velocity + pressure)")
-    ax.set_ylabel("wall time per step per DoF [µs]")
-    ax.set_title("Navier–Stokes projection step cost (Q2/Q1)")
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=8)
-    fig.tight_layout()
-    fig.savefig(os.path.join(HERE, "cost_per_dof.png"), dpi=120)
+    plot(results)
 
     total = time.perf_counter() - T_START
     with open(os.path.join(HERE, "results.csv"), "a") as f:
