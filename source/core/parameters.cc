@@ -613,7 +613,8 @@ namespace Suspension::Parameters
     prm.declare_entry("CFL number",
                       std::to_string(d.cfl),
                       Patterns::Double(1e-6, 100.),
-                      "Target CFL number max(|u| dt / h) / degree for the "
+                      "Target CFL number max |u| dt k / h (k the velocity "
+                      "degree, so h / k is the node spacing) for the "
                       "adaptive time step.");
     prm.declare_entry("Maximum time step",
                       std::to_string(d.maximum_time_step),
