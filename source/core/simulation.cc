@@ -114,10 +114,14 @@ namespace Suspension
                                         parameters.material.density));
     // A collapsing step means the flow blew up without (yet) a NaN.
     if (next < 1e-6 * ts.time_step)
-      throw std::runtime_error(
-        "the time step collapsed to " + std::to_string(next) + " at t = " + std::to_string(time) +
-        " (kinetic energy " + std::to_string(d.kinetic_energy) +
-        "): the flow is unstable; reduce 'Time stepping/CFL number' or 'Solid/Elastic number'");
+      {
+        std::ostringstream message;
+        message << "the time step collapsed to " << std::scientific << std::setprecision(3) << next
+                << " at t = " << time << " (kinetic energy " << d.kinetic_energy
+                << "): the flow is unstable; reduce 'Time stepping/CFL number' or "
+                   "'Solid/Elastic number', or refine the mesh";
+        throw std::runtime_error(message.str());
+      }
     // Land exactly on report times and on the end time.
     std::vector<double> targets = parameters.verification.report_times;
     targets.push_back(ts.end_time);
