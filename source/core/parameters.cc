@@ -250,6 +250,100 @@ namespace Suspension::Parameters
                        dim);
   }
 
+  // ---------------------------------------------------------- MeshRefinement
+  void MeshRefinement::declare(ParameterHandler &prm)
+  {
+    const MeshRefinement d;
+    prm.enter_subsection("Mesh refinement");
+    prm.declare_entry("Adaptive", d.enabled ? "true" : "false", Patterns::Bool(),
+                      "Adapt the mesh to the solid interface (and the velocity) "
+                      "during the run. The criteria below combine: each asks "
+                      "for a level per cell, the largest wins.");
+    prm.declare_entry("Minimum level", std::to_string(d.minimum_level),
+                      Patterns::Integer(0, 16),
+                      "Coarsest level allowed (refinements of the base mesh). "
+                      "Equal to 'Maximum level': a uniform mesh reached "
+                      "through the adaptive machinery.");
+    prm.declare_entry("Maximum level", std::to_string(d.maximum_level),
+                      Patterns::Integer(0, 16),
+                      "Finest level: the interface band is refined to it. At "
+                      "least 'Mesh/Global refinements'.");
+    prm.declare_entry("Interface threshold", "0.001", Patterns::Double(0, 0.5),
+                      "A cell belongs to the interface where epsilon < phi < "
+                      "1 - epsilon at one of its nodes or quadrature points.");
+    prm.declare_entry("Buffer cells", std::to_string(d.buffer_cells),
+                      Patterns::Integer(0, 20),
+                      "The interface band is widened by this many cells "
+                      "(face neighbours) on each side, so that the interface "
+                      "stays on the finest level between two adaptations.");
+    prm.declare_entry("Solid level", std::to_string(d.solid_level),
+                      Patterns::Integer(0, 16),
+                      "Level inside the solid (phi > 1/2, B varies there); 0: "
+                      "none.");
+    prm.declare_entry("Velocity refine fraction", "0", Patterns::Double(0, 1),
+                      "Kelly estimator on the velocity: the cells holding this "
+                      "fraction of the estimated error are refined one level "
+                      "(up to the maximum); 0 switches the estimator off.");
+    prm.declare_entry("Velocity coarsen fraction", "0", Patterns::Double(0, 1),
+                      "... and those holding this fraction may be coarsened.");
+    prm.declare_entry("Region", "", Patterns::Anything(),
+                      "Function expression of x, y[, z]: cells whose centre "
+                      "makes it positive are kept at 'Region level' at least "
+                      "(for example a wall band, abs(y) > 0.8). Empty: none.");
+    prm.declare_entry("Region level", std::to_string(d.region_level),
+                      Patterns::Integer(0, 16), "Level inside 'Region'.");
+    prm.declare_entry("Interval", std::to_string(d.interval), Patterns::Integer(0),
+                      "Adapt every this many steps; 0: from the CFL number, "
+                      "so that the interface cannot cross half the buffer "
+                      "between two adaptations (doc/method.md).");
+    prm.declare_entry("Initial cycles", std::to_string(d.initial_cycles),
+                      Patterns::Integer(0, 20),
+                      "Adapt-and-reinitialise cycles on the initial condition; "
+                      "0: maximum level - global refinements + 2.");
+    prm.leave_subsection();
+  }
+
+  void MeshRefinement::parse(ParameterHandler &prm, const unsigned int dim, const Mesh &mesh)
+  {
+    prm.enter_subsection("Mesh refinement");
+    enabled             = prm.get_bool("Adaptive");
+    minimum_level       = prm.get_integer("Minimum level");
+    maximum_level       = prm.get_integer("Maximum level");
+    interface_threshold = prm.get_double("Interface threshold");
+    buffer_cells        = prm.get_integer("Buffer cells");
+    solid_level         = prm.get_integer("Solid level");
+    refine_fraction     = prm.get_double("Velocity refine fraction");
+    coarsen_fraction    = prm.get_double("Velocity coarsen fraction");
+    region              = Utilities::trim(prm.get("Region"));
+    region_level        = prm.get_integer("Region level");
+    interval            = prm.get_integer("Interval");
+    initial_cycles      = prm.get_integer("Initial cycles");
+    prm.leave_subsection();
+    if (!enabled)
+      return;
+    if (maximum_level < mesh.global_refinements)
+      throw InputError("Mesh refinement/Maximum level",
+                       "must be at least 'Mesh/Global refinements' (" +
+                         std::to_string(mesh.global_refinements) + ")");
+    if (minimum_level > maximum_level)
+      throw InputError("Mesh refinement/Minimum level", "must be at most 'Maximum level'");
+    if (solid_level > maximum_level || region_level > maximum_level)
+      throw InputError(solid_level > maximum_level ? "Mesh refinement/Solid level" :
+                                                     "Mesh refinement/Region level",
+                       "must be at most 'Maximum level'");
+    if (refine_fraction + coarsen_fraction > 1.)
+      throw InputError("Mesh refinement/Velocity coarsen fraction",
+                       "refine and coarsen fractions add up to more than 1");
+    if (!region.empty())
+      check_expression("Mesh refinement/Region", {region, ""}, 1, dim);
+    if (!mesh.refinement_region.empty())
+      throw InputError("Mesh/Refinement region",
+                       "a hand-made region and an adaptive mesh do not mix; use "
+                       "'Mesh refinement/Region'");
+    if (initial_cycles == 0)
+      initial_cycles = maximum_level - std::min(mesh.global_refinements, minimum_level) + 2;
+  }
+
   // ------------------------------------------------------ BoundaryConditions
   BoundaryConditions::BoundaryConditions()
   {
@@ -794,6 +888,17 @@ namespace Suspension::Parameters
                       "swept value; with 'Tolerance' the relative deviation "
                       "of the last run (the finest, by convention) is "
                       "checked.");
+    prm.declare_entry("Sweep agreement",
+                      "0",
+                      Patterns::Double(0),
+                      "If positive: the last run's D must agree with the "
+                      "first run's to this relative difference (e.g. an "
+                      "adaptive run against a uniform one).");
+    prm.declare_entry("Sweep minimum cell reduction",
+                      "0",
+                      Patterns::Double(0),
+                      "If positive: the first run's final cell count over "
+                      "the last run's must be at least this.");
     prm.declare_entry("Refinement cycles",
                       "1",
                       Patterns::Integer(1, 8),
@@ -831,6 +936,8 @@ namespace Suspension::Parameters
     sweep_entry       = Utilities::trim(prm.get("Sweep entry"));
     sweep_values      = split(prm.get("Sweep values"), ',');
     sweep_expected_deformation = Utilities::trim(prm.get("Sweep expected deformation"));
+    sweep_agreement            = prm.get_double("Sweep agreement");
+    sweep_cell_reduction       = prm.get_double("Sweep minimum cell reduction");
     time_step_cycles  = prm.get_integer("Time step cycles");
     prm.leave_subsection();
     if (exact_solution == ExactSolutionType::function)
@@ -864,6 +971,7 @@ namespace Suspension::Parameters
                       "Space dimension of the scene: 2 or 3.");
     Geometry::declare(prm, dim);
     Mesh::declare(prm);
+    MeshRefinement::declare(prm);
     BoundaryConditions::declare(prm, dim);
     FlowDriving::declare(prm, dim);
     Material::declare(prm);
@@ -880,6 +988,7 @@ namespace Suspension::Parameters
     dimension = prm.get_integer("Dimension");
     geometry.parse(prm, dim);
     mesh.parse(prm, dim);
+    mesh_refinement.parse(prm, dim, mesh);
     boundary_conditions.parse(prm, dim);
     flow_driving.parse(prm, dim);
     material.parse(prm);

@@ -52,6 +52,7 @@ namespace Suspension
                     Triangulation<dim>::limit_level_difference_at_vertices,
                     parallel::distributed::Triangulation<dim>::default_setting)
     , scene(parameters)
+    , adaptor(parameters, triangulation)
     , space(triangulation, parameters.fluid_solver.velocity_degree,
             parameters.fluid_solver.pressure_degree)
     , fluid(parameters, scene, space, operators)
@@ -72,15 +73,74 @@ namespace Suspension
   void Simulation<dim>::setup()
   {
     TimerOutput::Scope scope(timer, "setup (mesh, DoFs, matrices)");
-    scene.create_mesh(triangulation);
+    create_initial_mesh();
     space.setup(scene);
     // a prescribed velocity needs the velocity space, but no matrix
     if (!prescribed_velocity)
       operators.reinit(space);
     fluid.initialize(prescribed_velocity.get());
     if (solid)
-      solid->setup(space);
+      solid->setup(space, adaptor.finest_cell_size());
     smallest_cell_size = smallest_cell();
+  }
+
+  template <int dim>
+  void Simulation<dim>::create_initial_mesh()
+  {
+    scene.create_mesh(triangulation);
+    if (!adaptor.enabled())
+      return;
+    // Refine towards the initial interface: set phi on the current mesh,
+    // flag, refine, and again, until nothing changes.
+    for (unsigned int cycle = 0; cycle < parameters.mesh_refinement.initial_cycles; ++cycle)
+      {
+        space.setup(scene);
+        if (solid)
+          solid->setup(space, adaptor.finest_cell_size());
+        if (!adaptor.flag(solid.get(), space, nullptr, 0.))
+          break;
+        triangulation.execute_coarsening_and_refinement();
+      }
+  }
+
+  template <int dim>
+  bool Simulation<dim>::adapt_mesh()
+  {
+    TimerOutput::Scope scope(timer, "mesh adaptation");
+    if (!adaptor.flag(solid.get(), space, prescribed_velocity ? nullptr : &fluid.velocity(),
+                      fluid.time()))
+      return false;
+    fluid.prepare_for_mesh_change();
+    if (solid)
+      solid->prepare_for_mesh_change();
+    triangulation.execute_coarsening_and_refinement();
+    space.setup(scene);
+    if (!prescribed_velocity)
+      operators.reinit(space);
+    fluid.finish_mesh_change(prescribed_velocity.get());
+    if (solid)
+      solid->finish_mesh_change(space);
+    smallest_cell_size = smallest_cell();
+    ++n_adaptations;
+    return true;
+  }
+
+  template <int dim>
+  void Simulation<dim>::add_mesh_statistics(const MeshLevels &levels, const bool adapted,
+                                            const double adapt_time)
+  {
+    // levels and counts of the mesh the step ran on; adapted: a new one
+    // for the next step
+    statistics.add_value("level_min", levels.min_level);
+    statistics.add_value("level_max", levels.max_level);
+    statistics.add_value("cells_finest", static_cast<unsigned long long>(levels.cells_on_finest));
+    if (solid)
+      statistics.add_value("coarse_interface_cells",
+                           static_cast<unsigned long long>(levels.coarse_interface_cells));
+    statistics.add_value("adapted", adapted ? 1 : 0);
+    statistics.add_value("wall_time_adapt", adapt_time);
+    statistics.set_scientific("wall_time_adapt", true);
+    statistics.set_precision("wall_time_adapt", 4);
   }
 
   template <int dim>
@@ -126,7 +186,7 @@ namespace Suspension
     std::vector<double> targets = parameters.verification.report_times;
     targets.push_back(ts.end_time);
     for (const double target : targets)
-      if (target > time + 1e-12 * next && target < time + next * (1. + 1e-9))
+      if (target > time + 1e-12 * next && target < time + next * (1. + 1e-3))
         return target - time;
     return next;
   }
@@ -510,11 +570,31 @@ namespace Suspension
           }
         steady = ts.steady_tolerance > 0 && fluid.relative_change_rate() < ts.steady_tolerance;
 
+        // statistics of the step on its own mesh, then the mesh for the next
         const double wall =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count();
         add_statistics_row(report, diagnostics, dt, wall);
         if (solid)
           add_solid_statistics(solid_diagnostics);
+        if (adaptor.enabled())
+          {
+            const MeshLevels levels = adaptor.levels(solid.get());
+            worst_coarse_interface  = std::max(worst_coarse_interface, levels.coarse_interface_cells);
+            bool       adapted      = false;
+            const auto adapt_start  = std::chrono::steady_clock::now();
+            if (adaptor.due(diagnostics.max_speed * dt))
+              adapted = adapt_mesh();
+            if (adapted)
+              {
+                diagnostics = fluid.compute_diagnostics();
+                if (solid)
+                  solid_diagnostics = solid->diagnostics();
+              }
+            add_mesh_statistics(levels, adapted,
+                                std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                                              adapt_start)
+                                  .count());
+          }
         last_driving_force = report.driving_force;
 
         for (const double t : report_times)
@@ -553,6 +633,15 @@ namespace Suspension
     pcout << std::defaultfloat << std::endl;
     for (const auto &line : last_probe_values)
       pcout << line << std::endl;
+    if (adaptor.enabled())
+      {
+        pcout << "  mesh: " << n_adaptations << " adaptations, now "
+              << triangulation.n_global_active_cells() << " cells";
+        if (solid)
+          pcout << "; interface cells below the finest level, most in any step: "
+                << worst_coarse_interface;
+        pcout << std::endl;
+      }
     if (solid)
       report_solid();
     report_errors(fluid.time(), steady);
@@ -586,6 +675,7 @@ namespace Suspension
     summary.time_step     = dt;
     summary.n_steps       = fluid.step_number();
     summary.n_dofs        = space.dof_velocity.n_dofs() + space.dof_pressure.n_dofs();
+    summary.n_cells       = triangulation.n_global_active_cells();
     return summary;
   }
 

@@ -64,10 +64,19 @@ namespace Suspension
           const auto &[value, r] = runs[i];
           pcout << "  " << std::setw(10) << value << "  D = " << std::fixed << std::setprecision(4)
                 << r.deformation << "  inclination = " << std::setprecision(2) << r.inclination
-                << " deg";
+                << " deg  cells " << r.n_cells;
           if (expected)
             {
-              const double e = expected->value(Point<1>(Utilities::string_to_double(value)));
+              // a value that is not a number (a switch) makes x = 0
+              double x = 0.;
+              try
+                {
+                  x = Utilities::string_to_double(value);
+                }
+              catch (...)
+                {
+                }
+              const double e = expected->value(Point<1>(x));
               deviation      = (r.deformation - e) / e;
               pcout << "  expected D = " << std::setprecision(4) << e << "  deviation "
                     << std::setprecision(1) << 100. * deviation << " %";
@@ -83,6 +92,22 @@ namespace Suspension
         pcout << "  D grows along the sweep: " << (monotonic_D ? "yes" : "no")
               << ", inclination falls along the sweep: " << (monotonic_theta ? "yes" : "no")
               << std::endl;
+      const RunSummary &first = runs.front().second, &last = runs.back().second;
+      if (v.sweep_agreement > 0)
+        {
+          const double difference = last.deformation / first.deformation - 1.;
+          pcout << "  last against first: D differs by " << std::fixed << std::setprecision(2)
+                << 100. * difference << " %, |difference| <= " << v.sweep_agreement << ": "
+                << (std::abs(difference) <= v.sweep_agreement ? "yes" : "no") << std::endl;
+        }
+      if (v.sweep_cell_reduction > 0)
+        {
+          const double reduction = double(first.n_cells) / last.n_cells;
+          pcout << "  cells first / last " << std::fixed << std::setprecision(2) << reduction
+                << ", >= " << v.sweep_cell_reduction << ": "
+                << (reduction >= v.sweep_cell_reduction ? "yes" : "no") << std::defaultfloat
+                << std::endl;
+        }
       if (expected && v.tolerance > 0)
         pcout << "  |deviation| of the last run <= " << v.tolerance << ": "
               << (std::abs(deviation) <= v.tolerance ? "yes" : "no") << std::endl;
@@ -104,7 +129,13 @@ namespace Suspension
     for (unsigned int cycle = 0; cycle < cycles; ++cycle)
       {
         Parameters::All p = parameters;
-        if (in_space)
+        if (in_space && p.mesh_refinement.enabled)
+          {
+            // an adaptive mesh refines its finest level
+            p.mesh_refinement.maximum_level += cycle;
+            p.mesh_refinement.initial_cycles += cycle;
+          }
+        else if (in_space)
           p.mesh.global_refinements += cycle;
         else
           p.time_stepping.time_step /= std::pow(2., cycle);

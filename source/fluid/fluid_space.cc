@@ -63,6 +63,13 @@ namespace Suspension::Fluid
 
     make_velocity_constraints(scene, true, velocity_constraints);
 
+    velocity_continuity.clear();
+    velocity_continuity.reinit(relevant_velocity);
+    DoFTools::make_hanging_node_constraints(dof_velocity, velocity_continuity);
+    for (const unsigned int d : scene.periodic_directions())
+      DoFTools::make_periodicity_constraints(dof_velocity, 2 * d, 2 * d + 1, d, velocity_continuity);
+    velocity_continuity.close();
+
     pressure_constraints.clear();
     pressure_constraints.reinit(relevant_pressure);
     DoFTools::make_hanging_node_constraints(dof_pressure, pressure_constraints);

@@ -20,7 +20,7 @@ namespace Suspension::Fluid
   {}
 
   template <int dim>
-  void ProjectionScheme<dim>::initialize(Function<dim> *velocity)
+  void ProjectionScheme<dim>::allocate_vectors()
   {
     const MPI_Comm comm = space.communicator();
     for (auto *v : {&u, &u_old, &u_older, &unit_response, &rhs_u})
@@ -31,7 +31,12 @@ namespace Suspension::Fluid
       v->reinit(space.owned_velocity, space.relevant_velocity, comm);
     for (auto *v : {&pressure_ghosted, &p_sharp_ghosted})
       v->reinit(space.owned_pressure, space.relevant_pressure, comm);
+  }
 
+  template <int dim>
+  void ProjectionScheme<dim>::initialize(Function<dim> *velocity)
+  {
+    allocate_vectors();
     scene.set_time(0.);
     if (velocity != nullptr)
       {
@@ -51,6 +56,57 @@ namespace Suspension::Fluid
     current_time = 0.;
     last_dt      = 0.;
     n_steps      = 0;
+  }
+
+  template <int dim>
+  void ProjectionScheme<dim>::prepare_for_mesh_change()
+  {
+    const MPI_Comm comm = space.communicator();
+    transfer_velocity_in.assign(2, VectorType());
+    transfer_pressure_in.assign(3, VectorType());
+    for (auto &v : transfer_velocity_in)
+      v.reinit(space.owned_velocity, space.relevant_velocity, comm);
+    for (auto &v : transfer_pressure_in)
+      v.reinit(space.owned_pressure, space.relevant_pressure, comm);
+    transfer_velocity_in[0] = u;
+    transfer_velocity_in[1] = u_old;
+    transfer_pressure_in[0] = p;
+    transfer_pressure_in[1] = psi;
+    transfer_pressure_in[2] = psi_old;
+    velocity_transfer = std::make_unique<Transfer>(space.dof_velocity);
+    pressure_transfer = std::make_unique<Transfer>(space.dof_pressure);
+    velocity_transfer->prepare_for_coarsening_and_refinement(
+      {&transfer_velocity_in[0], &transfer_velocity_in[1]});
+    pressure_transfer->prepare_for_coarsening_and_refinement(
+      {&transfer_pressure_in[0], &transfer_pressure_in[1], &transfer_pressure_in[2]});
+  }
+
+  template <int dim>
+  void ProjectionScheme<dim>::finish_mesh_change(Function<dim> *prescribed_velocity)
+  {
+    allocate_vectors();
+    std::vector<VectorType *> velocities = {&u, &u_old};
+    std::vector<VectorType *> pressures  = {&p, &psi, &psi_old};
+    velocity_transfer->interpolate(velocities);
+    pressure_transfer->interpolate(pressures);
+    velocity_transfer.reset();
+    pressure_transfer.reset();
+    transfer_velocity_in.clear();
+    transfer_pressure_in.clear();
+    for (auto *v : velocities)
+      space.velocity_continuity.distribute(*v);
+    for (auto *v : pressures)
+      space.pressure_constraints.distribute(*v);
+    if (prescribed_velocity != nullptr)
+      {
+        prescribed_velocity->set_time(current_time);
+        VectorTools::interpolate(space.dof_velocity, *prescribed_velocity, u);
+      }
+    u_older = u_old;
+    velocity_ghosted = u;
+    pressure_ghosted = p;
+    // the step's constraints live on the old mesh's DoFs
+    space.make_velocity_constraints(scene, !scene.has_inhomogeneous_velocity(), step_constraints);
   }
 
   template <int dim>

@@ -99,10 +99,10 @@ namespace Suspension::Solid
   }
 
   template <int dim>
-  void SolidPhase<dim>::setup(const Fluid::FluidSpace<dim> &fluid_space)
+  void SolidPhase<dim>::reinit_discretization(const Fluid::FluidSpace<dim> &fluid_space)
   {
     dof_handler.distribute_dofs(fe);
-    // hanging nodes and periodicity of the velocity only (its Dirichlet
+    // hanging nodes of the velocity only (its Dirichlet and periodic
     // values are read as they are)
     AffineConstraints<double> velocity_constraints;
     velocity_constraints.reinit(fluid_space.relevant_velocity);
@@ -116,18 +116,82 @@ namespace Suspension::Solid
     transport.initialize_velocity_vector(u0);
     transport.initialize_velocity_vector(u1);
     transport.initialize_velocity_vector(u_stage);
+    stress_values.reset();
+  }
 
-    double h = std::numeric_limits<double>::max();
-    for (const auto &cell : dof_handler.active_cell_iterators())
-      if (cell->is_locally_owned())
-        h = std::min(h, cell->minimum_vertex_distance());
-    h = Utilities::MPI::min(h, dof_handler.get_communicator());
-    VectorTools::interpolate(dof_handler, InitialSolid<dim>(parameters, fe.n_components(), h),
+  template <int dim>
+  void SolidPhase<dim>::setup(const Fluid::FluidSpace<dim> &fluid_space, const double interface_h)
+  {
+    reinit_discretization(fluid_space);
+    VectorTools::interpolate(dof_handler,
+                             InitialSolid<dim>(parameters, fe.n_components(), interface_h),
                              solution);
     if (parameters.solid.limiter)
       transport.limit(solution, true);
     initial_volume = diagnostics().volume;
     time           = 0.;
+  }
+
+  template <int dim>
+  void SolidPhase<dim>::prepare_for_mesh_change()
+  {
+    solution.update_ghost_values();
+    transfer = std::make_unique<parallel::distributed::SolutionTransfer<dim, VectorType>>(dof_handler);
+    transfer->prepare_for_coarsening_and_refinement(solution);
+  }
+
+  template <int dim>
+  void SolidPhase<dim>::finish_mesh_change(const Fluid::FluidSpace<dim> &fluid_space)
+  {
+    reinit_discretization(fluid_space);
+    transfer->interpolate(solution);
+    transfer.reset();
+    // The L2 projection onto a coarse cell keeps its mean but may
+    // overshoot at nodes: limit as after a transport stage.
+    solution.zero_out_ghost_values();
+    transport.limit(solution, true);
+    if (fe.n_components() > 1)
+      transport.limit_B(solution);
+  }
+
+  template <int dim>
+  std::vector<unsigned char> SolidPhase<dim>::classify_cells(const double epsilon) const
+  {
+    std::vector<unsigned char> phase(dof_handler.get_triangulation().n_active_cells(), fluid_cell);
+    const QGauss<dim>                    quadrature(fe.degree + 1);
+    FEValues<dim>                        fe_values(fe, quadrature, update_values | update_JxW_values);
+    const FEValuesExtractors::Scalar     phi_x(0);
+    std::vector<double>                  phi(quadrature.size());
+    std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          fe_values[phi_x].get_function_values(solution, phi);
+          double lo = 1., hi = 0., mean = 0., measure = 0.;
+          for (const unsigned int q : fe_values.quadrature_point_indices())
+            {
+              lo = std::min(lo, phi[q]);
+              hi = std::max(hi, phi[q]);
+              mean += phi[q] * fe_values.JxW(q);
+              measure += fe_values.JxW(q);
+            }
+          cell->get_dof_indices(dofs);
+          for (unsigned int i = 0; i < dofs.size(); ++i)
+            if (fe.system_to_component_index(i).first == 0)
+              {
+                lo = std::min(lo, solution(dofs[i]));
+                hi = std::max(hi, solution(dofs[i]));
+              }
+          // a value inside (epsilon, 1 - epsilon), or values on both sides
+          const bool inside_range = hi > epsilon && lo < 1. - epsilon;
+          auto &p = phase[cell->active_cell_index()];
+          if (inside_range)
+            p = interface_cell;
+          else if (mean > 0.5 * measure)
+            p = solid_cell;
+        }
+    return phase;
   }
 
   template <int dim>

@@ -79,6 +79,27 @@ namespace Suspension::Parameters
     void        parse(ParameterHandler &prm, unsigned int dim);
   };
 
+  /// Interface-adaptive meshes: which cells are refined, how often.
+  /// Levels count refinements of the base mesh (cell->level()).
+  struct MeshRefinement
+  {
+    bool         enabled             = false;
+    unsigned int minimum_level       = 0;
+    unsigned int maximum_level       = 0;
+    double       interface_threshold = 1e-3; // epsilon < phi < 1 - epsilon
+    unsigned int buffer_cells        = 3;
+    unsigned int solid_level         = 0;    // 0: no extra level inside
+    double       refine_fraction     = 0.;   // Kelly on the velocity; 0: off
+    double       coarsen_fraction    = 0.;
+    std::string  region;                     // expression > 0 at the centre
+    unsigned int region_level        = 0;
+    unsigned int interval            = 0;    // steps; 0: from the CFL number
+    unsigned int initial_cycles      = 0;    // 0: maximum - global + 2
+
+    static void declare(ParameterHandler &prm);
+    void        parse(ParameterHandler &prm, unsigned int dim, const Mesh &mesh);
+  };
+
   enum class BoundaryType
   {
     no_slip,
@@ -254,6 +275,8 @@ namespace Suspension::Parameters
     std::string         sweep_entry;
     std::vector<std::string> sweep_values;
     std::string         sweep_expected_deformation; // function of x = value
+    double              sweep_agreement      = 0.; // |D_last / D_first - 1|
+    double              sweep_cell_reduction = 0.; // cells_first / cells_last
 
     static void declare(ParameterHandler &prm, unsigned int dim);
     void        parse(ParameterHandler &prm, unsigned int dim);
@@ -266,6 +289,7 @@ namespace Suspension::Parameters
     std::string        input_file;
     Geometry           geometry;
     Mesh               mesh;
+    MeshRefinement     mesh_refinement;
     BoundaryConditions boundary_conditions;
     FlowDriving        flow_driving;
     Material           material;

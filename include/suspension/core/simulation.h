@@ -10,6 +10,7 @@
 #include <suspension/fluid/fluid_operators.h>
 #include <suspension/fluid/fluid_space.h>
 #include <suspension/fluid/projection_scheme.h>
+#include <suspension/mesh/mesh_adaptor.h>
 #include <suspension/postprocess/field_output.h>
 #include <suspension/postprocess/flow_verification.h>
 #include <suspension/solid/solid_phase.h>
@@ -31,6 +32,7 @@ namespace Suspension
     double                  time_step     = 0.;
     unsigned int            n_steps       = 0;
     types::global_dof_index n_dofs        = 0;
+    types::global_cell_index n_cells      = 0; // at the end
   };
 
   /**
@@ -47,6 +49,8 @@ namespace Suspension
 
   private:
     void   setup();
+    void   create_initial_mesh();
+    bool   adapt_mesh();
     double choose_time_step(double dt, double time, const Fluid::FlowDiagnostics &d) const;
     bool   output_due(double time, double dt) const;
     void   write_output();
@@ -54,6 +58,7 @@ namespace Suspension
     void   add_statistics_row(const Fluid::StepReport &r, const Fluid::FlowDiagnostics &d,
                               double dt, double wall_time);
     void   add_solid_statistics(const Solid::SolidDiagnostics &d);
+    void   add_mesh_statistics(const MeshLevels &levels, bool adapted, double adapt_time);
     void   report_solid();
     double smallest_cell() const;
     void   report_errors(double time, bool steady);
@@ -67,6 +72,7 @@ namespace Suspension
     mutable TimerOutput                       timer;
     parallel::distributed::Triangulation<dim> triangulation;
     Scene<dim>                                scene;
+    MeshAdaptor<dim>                          adaptor;
     Fluid::FluidSpace<dim>                    space;
     Fluid::FluidOperators<dim>                operators;
     Fluid::ProjectionScheme<dim>              fluid;
@@ -84,5 +90,7 @@ namespace Suspension
     double                                    smallest_cell_size = 0.; // per mesh
     double                                    last_output_time   = 0.;
     double                                    last_driving_force = 0.;
+    types::global_cell_index                  worst_coarse_interface = 0; // over all steps
+    unsigned int                              n_adaptations          = 0;
   };
 } // namespace Suspension

@@ -55,6 +55,7 @@ namespace Suspension::Fluid
     IndexSet owned_pressure, relevant_pressure;
 
     AffineConstraints<double> velocity_constraints;  // homogeneous
+    AffineConstraints<double> velocity_continuity;   // hanging + periodic only
     AffineConstraints<double> pressure_constraints;  // hanging + periodic
     AffineConstraints<double> increment_constraints; // ... + one pinned DoF
 

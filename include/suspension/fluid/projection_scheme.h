@@ -7,6 +7,9 @@
 #include <suspension/fluid/momentum_source.h>
 
 #include <deal.II/base/timer.h>
+#include <deal.II/distributed/solution_transfer.h>
+
+#include <memory>
 
 #include <optional>
 #include <vector>
@@ -67,6 +70,16 @@ namespace Suspension::Fluid
     /// `velocity`, a prescribed field, as it is), P^0 = 0.
     void initialize(Function<dim> *velocity = nullptr);
 
+    /// Before the mesh changes: hands the time levels the next step reads
+    /// (u^n, u^{n-1}, P^n, psi^n, psi^{n-1}) to SolutionTransfer.
+    void prepare_for_mesh_change();
+
+    /// After the mesh changed (the space and, unless the velocity is
+    /// prescribed, the operators rebuilt): the time levels on the new
+    /// mesh, hanging-node and periodic constraints applied. A prescribed
+    /// velocity is interpolated afresh instead.
+    void finish_mesh_change(Function<dim> *prescribed_velocity = nullptr);
+
     /// Advances from the current time by dt.
     StepReport advance(double dt, const std::vector<const MomentumSource<dim> *> &sources);
 
@@ -93,6 +106,7 @@ namespace Suspension::Fluid
   private:
     void       assemble_momentum_rhs(double dt, double t_new,
                                      const std::vector<const MomentumSource<dim> *> &sources);
+    void       allocate_vectors();
     void       update_unit_response();
     double     flux(const VectorType &u) const;
 
@@ -116,5 +130,9 @@ namespace Suspension::Fluid
     unsigned int n_steps      = 0;
     double       alpha = 1., beta_1 = 1., beta_2 = 0.;
     double       last_change_rate = 0.;
+
+    using Transfer = parallel::distributed::SolutionTransfer<dim, VectorType>;
+    std::unique_ptr<Transfer> velocity_transfer, pressure_transfer;
+    std::vector<VectorType>   transfer_velocity_in, transfer_pressure_in; // ghosted copies
   };
 } // namespace Suspension::Fluid

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <deal.II/base/function.h>
+#include <deal.II/distributed/solution_transfer.h>
 #include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/fe/fe_system.h>
@@ -25,6 +26,15 @@ namespace Suspension::Solid
     unsigned int limited_cells = 0, out_of_bound_means = 0, substeps = 0;
     double       min_det_B = 1., min_eigenvalue_B = 1.;
     std::array<double, 3> worst_B_location{}; // where min_eigenvalue_B is
+  };
+
+  /// What a cell holds, from the values of phi at its nodes and
+  /// quadrature points (see SolidPhase::classify_cells()).
+  enum CellPhase : unsigned char
+  {
+    fluid_cell     = 0,
+    interface_cell = 1,
+    solid_cell     = 2
   };
 
   /// Shape of one particle from the moments of phi.
@@ -59,8 +69,24 @@ namespace Suspension::Solid
     SolidPhase(const Parameters::All &parameters,
                const parallel::distributed::Triangulation<dim> &tria);
 
-    /// DoFs, operator and initial fields (phi from the scene, B = I).
-    void setup(const Fluid::FluidSpace<dim> &fluid_space);
+    /// DoFs, operator and initial fields (phi from the scene, B = I); the
+    /// smoothed profile is 'Interface width' cells of size `interface_h`.
+    void setup(const Fluid::FluidSpace<dim> &fluid_space, double interface_h);
+
+    /// Before the mesh changes: hands phi and B to a SolutionTransfer.
+    void prepare_for_mesh_change();
+
+    /// After the mesh (and the fluid space) changed: DoFs and operator on
+    /// the new mesh, fields transferred (DG coarsening is the L2
+    /// projection, so cell means and the integral of phi are kept), then
+    /// limited back into 0 <= phi <= 1 and B SPD.
+    void finish_mesh_change(const Fluid::FluidSpace<dim> &fluid_space);
+
+    /// Per active cell (index active_cell_index(), filled for locally
+    /// owned cells): interface if epsilon < phi < 1 - epsilon at a node or
+    /// quadrature point (or phi jumps across that range inside the cell),
+    /// solid if its mean is above 1/2, fluid otherwise.
+    std::vector<unsigned char> classify_cells(double epsilon) const;
 
     /// Largest sub-step of the transport for a velocity with
     /// max |u| k_u / h = speed_over_h.
@@ -97,6 +123,7 @@ namespace Suspension::Solid
     std::vector<std::string> component_names() const;
 
   private:
+    void reinit_discretization(const Fluid::FluidSpace<dim> &fluid_space);
     void check_B(const SolidDiagnostics &d, double time) const;
     void reset_B_in_fluid();
 
@@ -113,5 +140,6 @@ namespace Suspension::Solid
     VectorType             solution, stage, stage_rhs, u0, u1, u_stage;
     double                 initial_volume = 0., time = 0.;
     mutable std::unique_ptr<FEValues<dim>> stress_values;
+    std::unique_ptr<parallel::distributed::SolutionTransfer<dim, VectorType>> transfer;
   };
 } // namespace Suspension::Solid

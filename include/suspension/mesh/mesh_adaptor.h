@@ -1,0 +1,82 @@
+#pragma once
+
+#include <deal.II/distributed/tria.h>
+
+#include <suspension/core/parameters.h>
+#include <suspension/fluid/fluid_space.h>
+#include <suspension/fluid/fluid_operators.h>
+#include <suspension/solid/solid_phase.h>
+
+#include <memory>
+#include <vector>
+
+namespace Suspension
+{
+  /// Levels and counts of the current mesh.
+  struct MeshLevels
+  {
+    unsigned int            min_level = 0, max_level = 0;
+    types::global_cell_index cells_on_finest = 0;
+    /// interface cells (see SolidPhase::classify_cells) below the finest
+    /// level: 0 if the adaptation kept up with the interface
+    types::global_cell_index coarse_interface_cells = 0;
+  };
+
+  /**
+   * Decides where the mesh is fine: each criterion of the 'Mesh
+   * refinement' subsection asks for a level per cell, the largest wins,
+   * clamped to [minimum, maximum] level:
+   *
+   *  - the phi interface band, widened by 'Buffer cells' face neighbours
+   *    (across processor and periodic boundaries): the maximum level;
+   *  - the solid interior: 'Solid level';
+   *  - the 'Region' expression: 'Region level';
+   *  - Kelly's estimator on the velocity: one level up for the largest
+   *    'Velocity refine fraction' of the error, keep the level unless in
+   *    the smallest 'Velocity coarsen fraction'.
+   *
+   * Cells below their level are flagged for refinement, cells above it for
+   * coarsening; one adaptation moves a cell by at most one level.
+   */
+  template <int dim>
+  class MeshAdaptor
+  {
+  public:
+    MeshAdaptor(const Parameters::All &parameters,
+                parallel::distributed::Triangulation<dim> &triangulation);
+
+    bool enabled() const { return settings.enabled; }
+
+    /// Size of the smallest cell the mesh will have: on a uniform mesh the
+    /// smallest cell now, on an adaptive one that of the maximum level.
+    double finest_cell_size() const;
+
+    /// Called once per step with the distance the fastest material point
+    /// moved (max |u| dt): true when the mesh should be adapted now. With
+    /// a fixed 'Interval' every that many steps; otherwise once the
+    /// distance moved since the last adaptation reaches half the buffer
+    /// (buffer cells x finest cell size), so the interface cannot leave the
+    /// refined band in between.
+    bool due(double distance_moved);
+
+    /// Sets refine and coarsen flags (locally owned cells) for the state
+    /// at `time` (the 'Region' expression may depend on t). True if any
+    /// cell on any rank is flagged.
+    bool flag(const Solid::SolidPhase<dim> *solid,
+              const Fluid::FluidSpace<dim>  &space,
+              const Fluid::VectorType       *velocity,
+              double                         time);
+
+    MeshLevels levels(const Solid::SolidPhase<dim> *solid) const;
+
+  private:
+    /// Widens `band` (per active cell) by one face neighbour, `layers` times.
+    void dilate(std::vector<unsigned char> &band, unsigned int layers) const;
+
+    const Parameters::MeshRefinement           &settings;
+    parallel::distributed::Triangulation<dim> &triangulation;
+    std::unique_ptr<Function<dim>>             region;
+    unsigned int                               steps_since = 0;
+    double                                     distance_since = 0.;
+  };
+} // namespace Suspension
