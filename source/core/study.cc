@@ -88,7 +88,8 @@ namespace Suspension
               monotonic_theta = monotonic_theta && r.inclination < runs[i - 1].second.inclination;
             }
         }
-      if (runs.size() > 1)
+      // (a sweep of a numerical switch compares runs with each other instead)
+      if (runs.size() > 1 && v.sweep_agreement == 0)
         pcout << "  D grows along the sweep: " << (monotonic_D ? "yes" : "no")
               << ", inclination falls along the sweep: " << (monotonic_theta ? "yes" : "no")
               << std::endl;
