@@ -748,6 +748,12 @@ namespace Suspension::Parameters
                       d.directory,
                       Patterns::DirectoryName(),
                       "Where every output file goes; created if missing.");
+    prm.declare_entry("Write phi cells",
+                      "false",
+                      Patterns::Bool(),
+                      "At each output, also write phi_cells_NNNNN.txt: every "
+                      "cell's box, level and mean phi (plain text, drawn by "
+                      "scripts/plot_cells.py without ParaView).");
     prm.declare_entry("Write vtu",
                       "true",
                       Patterns::Bool(),
@@ -787,6 +793,7 @@ namespace Suspension::Parameters
     prm.enter_subsection("Output");
     directory         = prm.get("Directory");
     write_vtu         = prm.get_bool("Write vtu");
+    write_phi_cells   = prm.get_bool("Write phi cells");
     interval_steps    = prm.get_integer("Interval steps");
     interval_time     = prm.get_double("Interval time");
     progress_interval = prm.get_integer("Progress interval");

@@ -4,6 +4,7 @@
 
 #include <suspension/core/simulation.h>
 #include <suspension/fluid/body_force.h>
+#include <suspension/postprocess/cell_means.h>
 #include <suspension/postprocess/point_values.h>
 
 #include <chrono>
@@ -216,6 +217,15 @@ namespace Suspension
         field_output.write(space, fluid.velocity(), fluid.kinematic_pressure(),
                            parameters.material.density, fluid.time(), extra);
       }
+    if (solid && parameters.output.write_phi_cells)
+      {
+        std::ostringstream name;
+        name << parameters.output.directory << "/phi_cells_" << std::setw(5) << std::setfill('0')
+             << n_outputs << ".txt";
+        Postprocess::write_cell_means(solid->get_dof_handler(), solid->get_solution(), 0, "phi",
+                                      fluid.time(), name.str());
+      }
+    ++n_outputs;
     write_probes();
   }
 

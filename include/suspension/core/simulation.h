@@ -92,5 +92,6 @@ namespace Suspension
     double                                    last_driving_force = 0.;
     types::global_cell_index                  worst_coarse_interface = 0; // over all steps
     unsigned int                              n_adaptations          = 0;
+    unsigned int                              n_outputs              = 0;
   };
 } // namespace Suspension
