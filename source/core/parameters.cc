@@ -2,6 +2,7 @@
 #include <deal.II/base/utilities.h>
 
 #include <suspension/core/parameters.h>
+#include <suspension/core/particle_seeding.h>
 
 #include <fstream>
 #include <iostream>
@@ -597,10 +598,12 @@ namespace Suspension::Parameters
     prm.enter_subsection("Solid");
     prm.declare_entry("Initial fraction",
                       "none",
-                      Patterns::Selection("none|particles|function"),
+                      Patterns::Selection("none|particles|random particles|function"),
                       "Initial solid volume fraction phi: none (no solid, "
                       "no phi or B is allocated), particles (the list in "
-                      "'Particles' with a smoothed edge), or function.");
+                      "'Particles' with a smoothed edge), random particles "
+                      "(placed as the 'Seeding' subsection asks), or "
+                      "function.");
     prm.declare_entry("Particles",
                       "",
                       Patterns::Anything(),
@@ -648,6 +651,30 @@ namespace Suspension::Parameters
                       Patterns::Double(1e-3, 100.),
                       "Time-step limit dt sqrt(G / rho) / h of the explicit "
                       "elastic coupling (elastic wave crossing a cell).");
+    prm.enter_subsection("Seeding");
+    prm.declare_entry("Number of particles", "0", Patterns::Integer(0),
+                      "Particles to place at random (Initial fraction = "
+                      "random particles); 0: as many as 'Volume fraction' "
+                      "asks for.");
+    prm.declare_entry("Volume fraction", "0.1", Patterns::Double(0., 0.74),
+                      "Target solid volume fraction Phi (particle volume over "
+                      "the box), rounded to a whole number of particles; the "
+                      "run reports the actual N and Phi.");
+    prm.declare_entry("Radius", "0.1", Patterns::Double(0.),
+                      "Radius of every particle.");
+    prm.declare_entry("Minimum gap", "0", Patterns::Double(0.),
+                      "Smallest surface-to-surface distance between two "
+                      "particles (across periodic faces too).");
+    prm.declare_entry("Wall clearance", "0", Patterns::Double(0.),
+                      "Smallest distance from a particle's surface to a "
+                      "wall (non-periodic face).");
+    prm.declare_entry("Random seed", "1", Patterns::Integer(0),
+                      "Seed of the placement: the same seed gives the same "
+                      "particles on every machine.");
+    prm.declare_entry("Attempts per particle", "10000", Patterns::Integer(1),
+                      "Random draws for one particle before the request is "
+                      "rejected as too dense (an error, not a hang).");
+    prm.leave_subsection();
     prm.leave_subsection();
   }
 
@@ -655,9 +682,10 @@ namespace Suspension::Parameters
   {
     prm.enter_subsection("Solid");
     const std::string t = prm.get("Initial fraction");
-    initial_fraction = t == "none"      ? InitialFraction::none :
-                       t == "particles" ? InitialFraction::particles :
-                                          InitialFraction::function;
+    initial_fraction = t == "none"             ? InitialFraction::none :
+                       t == "particles"        ? InitialFraction::particles :
+                       t == "random particles" ? InitialFraction::random_particles :
+                                                 InitialFraction::function;
     interface_width     = prm.get_double("Interface width");
     constants           = prm.get("Function constants");
     fraction_expression = prm.get("Fraction expression");
@@ -667,7 +695,18 @@ namespace Suspension::Parameters
     transport_cfl       = prm.get_double("Transport CFL");
     elastic_number      = prm.get_double("Elastic number");
     const std::string list = prm.get("Particles");
+    prm.enter_subsection("Seeding");
+    seeding.n_particles     = prm.get_integer("Number of particles");
+    seeding.volume_fraction = prm.get_double("Volume fraction");
+    seeding.radius          = prm.get_double("Radius");
+    seeding.minimum_gap     = prm.get_double("Minimum gap");
+    seeding.wall_clearance  = prm.get_double("Wall clearance");
+    seeding.seed            = prm.get_integer("Random seed");
+    seeding.attempts        = prm.get_integer("Attempts per particle");
     prm.leave_subsection();
+    prm.leave_subsection();
+    if (initial_fraction == InitialFraction::random_particles && seeding.radius <= 0)
+      throw InputError("Solid/Seeding/Radius", "must be positive");
     particles.clear();
     for (const auto &p : split(list, ';'))
       {
@@ -1022,11 +1061,50 @@ namespace Suspension::Parameters
             throw InputError("Geometry/Subdivisions",
                              "a periodic direction needs at least 2 base cells");
         }
+    if (solid.initial_fraction == InitialFraction::random_particles)
+      seed_solid(dim);
     if (flow_driving.type != FlowDrivingType::none &&
         boundary_conditions.type[0] != BoundaryType::periodic)
       throw InputError("Flow driving/Type",
                        "a mean pressure gradient drives flow in x and needs "
                        "periodic x faces");
+  }
+
+  void All::seed_solid(const unsigned int dim)
+  {
+    SeedingRequest q;
+    q.dim = dim;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        q.lower[d]    = geometry.box_lower[d];
+        q.upper[d]    = geometry.box_upper[d];
+        q.periodic[d] = boundary_conditions.type[2 * d] == BoundaryType::periodic;
+      }
+    const auto &s     = solid.seeding;
+    q.n_particles     = s.n_particles;
+    q.volume_fraction = s.volume_fraction;
+    q.radius          = s.radius;
+    q.minimum_gap     = s.minimum_gap;
+    q.wall_clearance  = s.wall_clearance;
+    q.seed            = s.seed;
+    q.attempts        = s.attempts;
+    SeedingResult result;
+    try
+      {
+        result = seed_particles(q);
+      }
+    catch (const std::exception &e)
+      {
+        throw InputError(s.n_particles > 0 ? "Solid/Seeding/Number of particles" :
+                                             "Solid/Seeding/Volume fraction",
+                         e.what());
+      }
+    solid.particles              = result.particles;
+    solid.initial_fraction       = InitialFraction::particles;
+    solid.seeded                 = true;
+    solid.seeded_volume_fraction = result.volume_fraction;
+    solid.seeded_closest_gap     = result.closest_gap;
+    solid.seeded_closest_wall    = result.closest_wall;
   }
 
   unsigned int read_dimension(const std::string &filename)

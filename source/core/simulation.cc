@@ -490,6 +490,33 @@ namespace Suspension
           << space.dof_velocity.n_dofs() << " velocity + " << space.dof_pressure.n_dofs()
           << " pressure DoFs" << std::endl;
 
+    if (parameters.solid.seeded)
+      {
+        const auto &s = parameters.solid;
+        pcout << "  seeded " << s.particles.size() << " particles of radius " << s.seeding.radius
+              << ": volume fraction " << std::setprecision(6) << s.seeded_volume_fraction
+              << " (asked " << (s.seeding.n_particles > 0 ? "N = " : "Phi = ")
+              << (s.seeding.n_particles > 0 ? double(s.seeding.n_particles) :
+                                              s.seeding.volume_fraction)
+              << "), closest gap " << s.seeded_closest_gap << " (at least "
+              << s.seeding.minimum_gap << "), closest wall " << s.seeded_closest_wall
+              << " (at least " << s.seeding.wall_clearance << ")" << std::defaultfloat
+              << std::endl;
+        // Phi is met to half a particle's volume fraction (N is a whole number)
+        const double one = s.seeded_volume_fraction / s.particles.size();
+        const bool   as_asked =
+          s.seeding.n_particles > 0 ?
+            s.particles.size() == s.seeding.n_particles :
+            std::abs(s.seeded_volume_fraction - s.seeding.volume_fraction) <= 0.5 * one + 1e-12;
+        pcout << "  N and Phi as asked: " << (as_asked ? "yes" : "no")
+              << ", no overlap and wall clearance kept: "
+              << (s.seeded_closest_gap >= s.seeding.minimum_gap &&
+                      s.seeded_closest_wall >= s.seeding.wall_clearance ?
+                    "yes" :
+                    "no")
+              << std::endl;
+      }
+
     std::vector<const Fluid::MomentumSource<dim> *> sources;
     if (body_force)
       sources.push_back(body_force.get());

@@ -191,6 +191,7 @@ namespace Suspension::Parameters
   {
     none,
     particles,
+    random_particles,
     function
   };
 
@@ -207,6 +208,23 @@ namespace Suspension::Parameters
     bool                             limiter       = true;
     double                           transport_cfl = 0.5;
     double                           elastic_number = 0.5;
+
+    /// 'Initial fraction = random particles': filled into `particles` by
+    /// All::parse once the box and its periodic faces are known.
+    struct Seeding
+    {
+      unsigned int n_particles     = 0;
+      double       volume_fraction = 0.1;
+      double       radius          = 0.1;
+      double       minimum_gap     = 0.;
+      double       wall_clearance  = 0.;
+      unsigned int seed            = 1;
+      unsigned int attempts        = 10000;
+    } seeding;
+    bool   seeded                  = false;
+    double seeded_volume_fraction  = 0.;
+    double seeded_closest_gap      = 0.;
+    double seeded_closest_wall     = 0.;
 
     bool enabled() const { return initial_fraction != InitialFraction::none; }
     bool elastic() const { return enabled() && shear_modulus > 0.; }
@@ -303,6 +321,11 @@ namespace Suspension::Parameters
 
     static void declare(ParameterHandler &prm, unsigned int dim);
     void        parse(ParameterHandler &prm, unsigned int dim);
+
+  private:
+    /// Initial fraction = random particles: places them (InputError if
+    /// they do not fit).
+    void seed_solid(unsigned int dim);
   };
 
   /// Reads only `Dimension` from a file (other entries are skipped).
