@@ -110,7 +110,7 @@ namespace Suspension
                 << std::endl;
         }
       if (expected && v.tolerance > 0)
-        pcout << "  |deviation| of the last run <= " << v.tolerance << ": "
+        pcout << "  |deviation| of the last run <= " << std::setprecision(6) << v.tolerance << ": "
               << (std::abs(deviation) <= v.tolerance ? "yes" : "no") << std::endl;
     }
   } // namespace

@@ -32,6 +32,7 @@ expect bad_expression     "$dir/bad_expression.prm"    -- "bad_expression.prm" "
 expect unpaired_periodic  "$dir/unpaired_periodic.prm" -- "unpaired_periodic.prm" "Face x-/Type" "pairs"
 expect bad_dimension      "$dir/bad_dimension.prm"     -- "bad_dimension.prm" "Dimension"
 expect missing_file       "$dir/no_such_file.prm"      -- "no_such_file.prm" "cannot read"
+expect too_dense          "$dir/too_dense.prm"         -- "too_dense.prm" "Solid/Seeding/Volume fraction" "could place only"
 expect no_argument                                     -- "no parameter file"
 
 echo "$failures failure(s)"
