@@ -304,7 +304,7 @@ namespace Suspension::Solid
                   for (unsigned int c = 0; c < n_B; ++c)
                     B[SymmetricTensor<2, dim>::unrolled_to_component_indices(c)] = values[q][1 + c];
                   det_min = std::min(det_min, determinant(B));
-                  const double smallest = eigenvalues(B)[dim - 1];
+                  const double smallest = smallest_eigenvalue(B);
                   if (smallest < eig_min || !std::isfinite(smallest))
                     {
                       eig_min = smallest;

@@ -367,7 +367,7 @@ namespace Suspension::Solid
       SymmetricTensor<2, dim> B;
       for (unsigned int c = 0; c < n_B; ++c)
         B[SymmetricTensor<2, dim>::unrolled_to_component_indices(c)] = t[c][v];
-      return eigenvalues(B)[dim - 1];
+      return smallest_eigenvalue(B);
     };
     for (unsigned int cell = 0; cell < matrix_free.n_cell_batches(); ++cell)
       {

@@ -1,6 +1,7 @@
 #pragma once
 
 #include <deal.II/base/quadrature_lib.h>
+#include <deal.II/base/symmetric_tensor.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/la_parallel_vector.h>
@@ -10,6 +11,27 @@ namespace Suspension::Solid
 {
   using namespace dealii;
   using VectorType = LinearAlgebra::distributed::Vector<double>;
+
+  /**
+   * Smallest eigenvalue of a symmetric tensor, robust for nearly isotropic
+   * ones (B close to I). deal.II's eigenvalues() of a 2x2 tensor takes the
+   * square root of tr^2 - 4 det, which round-off makes negative (NaN) when
+   * the eigenvalues nearly coincide and the off-diagonal entry is tiny but
+   * not zero; the half-difference form below has no such cancellation. In
+   * 3D the Jacobi eigensolver is used.
+   */
+  template <int dim>
+  double smallest_eigenvalue(const SymmetricTensor<2, dim> &t)
+  {
+    if constexpr (dim == 2)
+      {
+        const double mean = 0.5 * (t[0][0] + t[1][1]);
+        const double half = 0.5 * (t[0][0] - t[1][1]);
+        return mean - std::sqrt(half * half + t[0][1] * t[0][1]);
+      }
+    else
+      return eigenvectors(t, SymmetricTensorEigenvectorMethod::jacobi)[dim - 1].first;
+  }
 
   /// Smallest and largest values seen by the limiter, and its work.
   struct LimiterReport
