@@ -16,6 +16,8 @@ matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 from matplotlib.collections import PolyCollection
 
+from statistics_table import read_table as read_statistics
+
 
 def read_cells(path):
     time, rows = None, []
@@ -26,17 +28,6 @@ def read_cells(path):
             elif not line.startswith("#") and line.strip():
                 rows.append([float(v) for v in line.split()])
     return time, rows
-
-
-def read_statistics(path):
-    names, rows = [], []
-    with open(path) as f:
-        for line in f:
-            if line.startswith("#"):
-                names.append(line.split(":", 1)[1].strip())
-            elif line.strip():
-                rows.append([float(v) for v in line.split()])
-    return {n: [r[i] for r in rows] for i, n in enumerate(names)}
 
 
 p = argparse.ArgumentParser()

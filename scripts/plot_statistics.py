@@ -16,16 +16,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt
 
-
-def read(path):
-    names, rows = [], []
-    with open(path) as f:
-        for line in f:
-            if line.startswith("#"):
-                names.append(line.split(":", 1)[1].strip())
-            elif line.strip():
-                rows.append([float(v) for v in line.split()])
-    return {n: [r[i] for r in rows] for i, n in enumerate(names)}
+from statistics_table import read_table as read
 
 
 p = argparse.ArgumentParser()

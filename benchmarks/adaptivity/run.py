@@ -39,6 +39,9 @@ REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
 WORK = os.path.join(HERE, "work")
 QUICK = "--quick" in sys.argv
 OUT = WORK if QUICK else HERE
+sys.path.insert(0, os.path.join(REPO, "scripts"))
+from statistics_table import read_table as read_statistics  # noqa: E402
+
 SUSPENSION = os.environ.get("SUSPENSION", os.path.join(REPO, "build", "suspension"))
 
 # (dim, kind, finest level); "reference" is adaptive
@@ -46,17 +49,6 @@ CASES = ([(2, "uniform", l) for l in (4, 5, 6)] + [(2, "adaptive", l) for l in (
          + [(2, "reference", 8)] + [(3, "uniform", 4), (3, "adaptive", 4)])
 if QUICK:
     CASES = [(2, "uniform", 4), (2, "adaptive", 4), (2, "uniform", 5), (2, "adaptive", 5)]
-
-
-def read_statistics(path):
-    names, rows = [], []
-    with open(path) as f:
-        for line in f:
-            if line.startswith("#"):
-                names.append(line.split(":", 1)[1].strip())
-            elif line.strip():
-                rows.append(line.split())
-    return {n: [float(r[i]) for r in rows] for i, n in enumerate(names)}
 
 
 def run(dim, kind, level):
