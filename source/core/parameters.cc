@@ -651,6 +651,12 @@ namespace Suspension::Parameters
                       Patterns::Double(1e-3, 100.),
                       "Time-step limit dt sqrt(G / rho) / h of the explicit "
                       "elastic coupling (elastic wave crossing a cell).");
+    prm.declare_entry("Body force", zero_vector(dim), Patterns::Anything(),
+                      "Force per unit volume of solid g(x, y[, z], t), one "
+                      "expression per component separated by ';', applied as "
+                      "phi g: the buoyancy (rho_s - rho_f) g of particles "
+                      "heavier than the fluid, or a push that drives particles "
+                      "into each other or a wall (uses 'Function constants').");
     prm.enter_subsection("Seeding");
     prm.declare_entry("Number of particles", "0", Patterns::Integer(0),
                       "Particles to place at random (Initial fraction = "
@@ -675,6 +681,25 @@ namespace Suspension::Parameters
                       "Random draws for one particle before the request is "
                       "rejected as too dense (an error, not a hang).");
     prm.leave_subsection();
+    prm.enter_subsection("Contact force");
+    prm.declare_entry("Enabled", "auto", Patterns::Selection("auto|on|off"),
+                      "Short-range repulsion f = mu V r (a1/d + a2/d^2) n in "
+                      "fluid cells where the gap d between two particles, or "
+                      "a particle and a no-slip wall, is between dx and "
+                      "Range dx (dx the local cell size; n towards the "
+                      "nearest surface). auto: on with two or more particles.");
+    prm.declare_entry("a1", "550", Patterns::Double(0.),
+                      "Coefficient of 1/d (the paper's 550).");
+    prm.declare_entry("a2", "35", Patterns::Double(0.),
+                      "Coefficient of 1/d^2 (the paper's 35).");
+    prm.declare_entry("Velocity scale", "0", Patterns::Double(0.),
+                      "V in the force; 0: the bulk velocity of 'Flow "
+                      "driving' (a constant-flow-rate channel).");
+    prm.declare_entry("Radius", "0", Patterns::Double(0.),
+                      "r in the force; 0: the particles' radius.");
+    prm.declare_entry("Range", "3", Patterns::Double(1., 20.),
+                      "Largest gap that is pushed apart, in cells.");
+    prm.leave_subsection();
     prm.leave_subsection();
   }
 
@@ -694,6 +719,7 @@ namespace Suspension::Parameters
     limiter             = prm.get_bool("Limiter");
     transport_cfl       = prm.get_double("Transport CFL");
     elastic_number      = prm.get_double("Elastic number");
+    body_force          = {prm.get("Body force"), constants};
     const std::string list = prm.get("Particles");
     prm.enter_subsection("Seeding");
     seeding.n_particles     = prm.get_integer("Number of particles");
@@ -704,9 +730,18 @@ namespace Suspension::Parameters
     seeding.seed            = prm.get_integer("Random seed");
     seeding.attempts        = prm.get_integer("Attempts per particle");
     prm.leave_subsection();
+    prm.enter_subsection("Contact force");
+    contact.mode           = prm.get("Enabled");
+    contact.a1             = prm.get_double("a1");
+    contact.a2             = prm.get_double("a2");
+    contact.velocity_scale = prm.get_double("Velocity scale");
+    contact.radius         = prm.get_double("Radius");
+    contact.range          = prm.get_double("Range");
+    prm.leave_subsection();
     prm.leave_subsection();
     if (initial_fraction == InitialFraction::random_particles && seeding.radius <= 0)
       throw InputError("Solid/Seeding/Radius", "must be positive");
+    check_expression("Solid/Body force", body_force, dim, dim);
     particles.clear();
     for (const auto &p : split(list, ';'))
       {
@@ -1063,11 +1098,36 @@ namespace Suspension::Parameters
         }
     if (solid.initial_fraction == InitialFraction::random_particles)
       seed_solid(dim);
+    resolve_contact_force();
     if (flow_driving.type != FlowDrivingType::none &&
         boundary_conditions.type[0] != BoundaryType::periodic)
       throw InputError("Flow driving/Type",
                        "a mean pressure gradient drives flow in x and needs "
                        "periodic x faces");
+  }
+
+  void All::resolve_contact_force()
+  {
+    auto &c   = solid.contact;
+    c.enabled = solid.enabled() &&
+                (c.mode == "on" || (c.mode == "auto" && solid.particles.size() >= 2));
+    if (!c.enabled)
+      return;
+    if (c.radius == 0.)
+      {
+        if (solid.particles.empty())
+          throw InputError("Solid/Contact force/Radius",
+                           "must be given when phi is an expression (no particle list)");
+        c.radius = solid.particles.front().back();
+      }
+    if (c.velocity_scale == 0.)
+      {
+        if (flow_driving.type != FlowDrivingType::constant_flow_rate)
+          throw InputError("Solid/Contact force/Velocity scale",
+                           "must be given when there is no constant flow rate "
+                           "(its bulk velocity is the default)");
+        c.velocity_scale = flow_driving.bulk_velocity;
+      }
   }
 
   void All::seed_solid(const unsigned int dim)

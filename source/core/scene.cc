@@ -55,6 +55,25 @@ namespace Suspension
   }
 
   template <int dim>
+  std::vector<std::pair<unsigned int, double>> Scene<dim>::no_slip_walls() const
+  {
+    std::vector<std::pair<unsigned int, double>> walls;
+    for (unsigned int f = 0; f < 2 * dim; ++f)
+      if (parameters.boundary_conditions.type[f] == Parameters::BoundaryType::no_slip)
+        walls.emplace_back(f / 2, f % 2 == 0 ? lower_corner()[f / 2] : upper_corner()[f / 2]);
+    return walls;
+  }
+
+  template <int dim>
+  std::array<double, dim> Scene<dim>::periods() const
+  {
+    std::array<double, dim> lengths{};
+    for (const unsigned int d : periodic)
+      lengths[d] = upper_corner()[d] - lower_corner()[d];
+    return lengths;
+  }
+
+  template <int dim>
   double Scene<dim>::volume() const
   {
     double v = 1.;

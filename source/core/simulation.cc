@@ -65,6 +65,9 @@ namespace Suspension
       prescribed_velocity = make_function<dim>(parameters.fluid_solver.prescribed_velocity, dim);
     if (parameters.solid.enabled())
       solid = std::make_unique<Solid::SolidPhase<dim>>(parameters, triangulation);
+    if (parameters.solid.contact.enabled)
+      contact = std::make_unique<Solid::ContactForce<dim>>(parameters, scene.no_slip_walls(),
+                                                           scene.periods());
     if (!parameters.flow_driving.body_force.is_zero())
       body_force = std::make_unique<Fluid::BodyForce<dim>>(
         make_function<dim>(parameters.flow_driving.body_force, dim));
@@ -348,6 +351,67 @@ namespace Suspension
   }
 
   template <int dim>
+  void Simulation<dim>::update_contact_force()
+  {
+    if (!contact)
+      return;
+    TimerOutput::Scope scope(timer, "contact force");
+    contact_diagnostics = contact->update(*solid);
+    const auto &c       = contact_diagnostics;
+    const auto  smaller = [](const double seen, const double now) {
+      return now < 0. ? seen : seen < 0. ? now : std::min(seen, now);
+    };
+    closest_gap_seen  = smaller(closest_gap_seen, c.closest_gap);
+    closest_wall_seen = smaller(closest_wall_seen, c.closest_wall);
+    smallest_contact_cell = c.smallest_cell;
+    fewest_particles      = std::min(fewest_particles, c.n_particles);
+    most_particles        = std::max(most_particles, c.n_particles);
+  }
+
+  template <int dim>
+  void Simulation<dim>::add_contact_statistics()
+  {
+    const auto &c = contact_diagnostics;
+    statistics.add_value("particles", c.n_particles);
+    statistics.add_value("contact_cells", c.active_cells);
+    statistics.add_value("gap_min", c.closest_gap);
+    statistics.add_value("wall_gap_min", c.closest_wall);
+    statistics.add_value("contact_force_max", c.largest_force);
+    for (const auto &column : {"gap_min", "wall_gap_min", "contact_force_max"})
+      {
+        statistics.set_scientific(column, true);
+        statistics.set_precision(column, 6);
+      }
+  }
+
+  template <int dim>
+  void Simulation<dim>::report_contact() const
+  {
+    const double dx = smallest_contact_cell;
+    pcout << "  contact: particles labelled " << fewest_particles << " to " << most_particles
+          << " (seeded " << parameters.solid.particles.size() << "), interface cell dx = "
+          << std::setprecision(6) << dx << std::endl;
+    const auto in_cells = [&](const double gap) {
+      std::ostringstream out;
+      if (gap < 0.)
+        out << "none within " << parameters.solid.contact.range << " dx";
+      else
+        out << std::setprecision(4) << gap << " (" << std::setprecision(3) << gap / dx
+            << " dx)";
+      return out.str();
+    };
+    pcout << "  closest gap between particles " << in_cells(closest_gap_seen)
+          << ", closest to a wall " << in_cells(closest_wall_seen) << std::endl;
+    const bool apart =
+      fewest_particles == parameters.solid.particles.size() &&
+      most_particles == parameters.solid.particles.size() &&
+      (closest_gap_seen < 0. || closest_gap_seen >= dx) &&
+      (closest_wall_seen < 0. || closest_wall_seen >= dx);
+    pcout << "  particles never merged and kept a gap >= dx: " << (apart ? "yes" : "no")
+          << std::endl;
+  }
+
+  template <int dim>
   void Simulation<dim>::report_solid()
   {
     const auto &d = solid_diagnostics;
@@ -520,8 +584,10 @@ namespace Suspension
     std::vector<const Fluid::MomentumSource<dim> *> sources;
     if (body_force)
       sources.push_back(body_force.get());
-    if (solid && parameters.solid.elastic())
+    if (solid && solid->pushes_fluid())
       sources.push_back(solid.get());
+    if (contact)
+      sources.push_back(contact.get());
     if (solid)
       solid_diagnostics = solid->diagnostics();
 
@@ -579,6 +645,7 @@ namespace Suspension
                     throw;
                   }
               }
+            update_contact_force();
             try
               {
                 report = fluid.advance(dt, sources);
@@ -613,6 +680,8 @@ namespace Suspension
         add_statistics_row(report, diagnostics, dt, wall);
         if (solid)
           add_solid_statistics(solid_diagnostics);
+        if (contact)
+          add_contact_statistics();
         if (adaptor.enabled())
           {
             const MeshLevels levels = adaptor.levels(solid.get());
@@ -681,6 +750,8 @@ namespace Suspension
       }
     if (solid)
       report_solid();
+    if (contact)
+      report_contact();
     report_errors(fluid.time(), steady);
     report_verdicts(steady);
     if (parameters.verification.reference_data == Parameters::ReferenceData::ghia_re100)

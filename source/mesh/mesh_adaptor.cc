@@ -5,6 +5,7 @@
 #include <deal.II/numerics/error_estimator.h>
 
 #include <suspension/core/scene.h>
+#include <suspension/mesh/face_neighbours.h>
 #include <suspension/mesh/mesh_adaptor.h>
 
 #include <cmath>
@@ -61,28 +62,8 @@ namespace Suspension
   {
     using Cell = typename Triangulation<dim>::active_cell_iterator;
     const auto marked_neighbour = [&](const Cell &cell) {
-      for (const unsigned int f : cell->face_indices())
-        {
-          const bool periodic = cell->has_periodic_neighbor(f);
-          if (cell->at_boundary(f) && !periodic)
-            continue;
-          const auto neighbour = cell->neighbor_or_periodic_neighbor(f);
-          if (neighbour->is_active())
-            {
-              if (band[neighbour->active_cell_index()])
-                return true;
-              continue;
-            }
-          // a finer neighbour: the children behind this face (2:1 balance)
-          for (unsigned int sf = 0; sf < GeometryInfo<dim>::max_children_per_face; ++sf)
-            {
-              const Cell child = periodic ? cell->periodic_neighbor_child_on_subface(f, sf) :
-                                            cell->neighbor_child_on_subface(f, sf);
-              if (band[child->active_cell_index()])
-                return true;
-            }
-        }
-      return false;
+      return for_each_face_neighbour<dim>(
+        cell, [&](const Cell &neighbour) { return band[neighbour->active_cell_index()] != 0; });
     };
 
     for (unsigned int layer = 0; layer < layers; ++layer)

@@ -83,7 +83,10 @@ namespace Suspension::Solid
     : parameters(parameters)
     , fe(make_fe<dim>(parameters.solid))
     , dof_handler(tria)
-  {}
+  {
+    if (!parameters.solid.body_force.is_zero())
+      body_force = make_function<dim>(parameters.solid.body_force, dim);
+  }
 
   template <int dim>
   std::vector<std::string> SolidPhase<dim>::component_names() const
@@ -482,19 +485,28 @@ namespace Suspension::Solid
 
   template <int dim>
   void SolidPhase<dim>::add(const typename Triangulation<dim>::active_cell_iterator &cell,
-                            const std::vector<Point<dim>> &,
+                            const std::vector<Point<dim>> &points,
                             const std::vector<Point<dim>> &unit_points,
-                            const double,
-                            std::vector<Tensor<1, dim>> &,
+                            const double                   time,
+                            std::vector<Tensor<1, dim>> &force,
                             std::vector<SymmetricTensor<2, dim>> &stress) const
   {
-    if (fe.n_components() == 1)
+    if (!pushes_fluid())
       return;
     if (!stress_values || stress_values->n_quadrature_points != unit_points.size())
       stress_values = std::make_unique<FEValues<dim>>(fe, Quadrature<dim>(unit_points), update_values);
     stress_values->reinit(Fluid::FluidSpace<dim>::cell_of(cell, dof_handler));
     std::vector<Vector<double>> values(unit_points.size(), Vector<double>(fe.n_components()));
     stress_values->get_function_values(solution, values);
+    if (body_force)
+      {
+        body_force->set_time(time);
+        for (unsigned int q = 0; q < points.size(); ++q)
+          for (unsigned int d = 0; d < dim; ++d)
+            force[q][d] += values[q][0] * body_force->value(points[q], d);
+      }
+    if (fe.n_components() == 1)
+      return;
     const double G = parameters.solid.shear_modulus;
     for (unsigned int q = 0; q < unit_points.size(); ++q)
       for (unsigned int c = 0; c < n_B; ++c)

@@ -208,6 +208,8 @@ namespace Suspension::Parameters
     bool                             limiter       = true;
     double                           transport_cfl = 0.5;
     double                           elastic_number = 0.5;
+    /// force per unit volume of solid, applied as phi g (x, t)
+    FunctionExpression               body_force{"", ""};
 
     /// 'Initial fraction = random particles': filled into `particles` by
     /// All::parse once the box and its periodic faces are known.
@@ -221,6 +223,19 @@ namespace Suspension::Parameters
       unsigned int seed            = 1;
       unsigned int attempts        = 10000;
     } seeding;
+    /// Short-range repulsion between particles and from walls (Rosti et
+    /// al.): f = mu V r (a1/d + a2/d^2) n for gaps dx <= d <= range dx.
+    struct Contact
+    {
+      std::string mode           = "auto"; // auto | on | off
+      bool        enabled        = false;  // resolved by All::parse
+      double      a1             = 550.;
+      double      a2             = 35.;
+      double      velocity_scale = 0.;     // 0: the bulk velocity
+      double      radius         = 0.;     // 0: the particles' radius
+      double      range          = 3.;     // in cells
+    } contact;
+
     bool   seeded                  = false;
     double seeded_volume_fraction  = 0.;
     double seeded_closest_gap      = 0.;
@@ -326,6 +341,8 @@ namespace Suspension::Parameters
     /// Initial fraction = random particles: places them (InputError if
     /// they do not fit).
     void seed_solid(unsigned int dim);
+    /// 'Solid/Contact force': on or off, and its defaults (radius, speed).
+    void resolve_contact_force();
   };
 
   /// Reads only `Dimension` from a file (other entries are skipped).

@@ -5,6 +5,7 @@
 
 #include <suspension/core/parameters.h>
 
+#include <array>
 #include <map>
 #include <memory>
 #include <vector>
@@ -51,6 +52,12 @@ namespace Suspension
 
     /// Domain measure |Omega|.
     double volume() const;
+
+    /// The no-slip faces as (direction, coordinate of the plane).
+    std::vector<std::pair<unsigned int, double>> no_slip_walls() const;
+
+    /// Length of each periodic direction, 0 for the others.
+    std::array<double, dim> periods() const;
 
     Point<dim> lower_corner() const;
     Point<dim> upper_corner() const;

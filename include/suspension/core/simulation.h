@@ -13,8 +13,10 @@
 #include <suspension/mesh/mesh_adaptor.h>
 #include <suspension/postprocess/field_output.h>
 #include <suspension/postprocess/flow_verification.h>
+#include <suspension/solid/contact_force.h>
 #include <suspension/solid/solid_phase.h>
 
+#include <limits>
 #include <memory>
 #include <vector>
 
@@ -58,6 +60,9 @@ namespace Suspension
     void   add_statistics_row(const Fluid::StepReport &r, const Fluid::FlowDiagnostics &d,
                               double dt, double wall_time);
     void   add_solid_statistics(const Solid::SolidDiagnostics &d);
+    void   update_contact_force();
+    void   add_contact_statistics();
+    void   report_contact() const;
     void   add_mesh_statistics(const MeshLevels &levels, bool adapted, double adapt_time);
     void   report_solid();
     double smallest_cell() const;
@@ -80,6 +85,12 @@ namespace Suspension
     std::unique_ptr<Function<dim>>            prescribed_velocity;
     std::unique_ptr<Solid::SolidPhase<dim>>   solid;
     Solid::SolidDiagnostics                   solid_diagnostics;
+    std::unique_ptr<Solid::ContactForce<dim>> contact;
+    Solid::ContactDiagnostics                 contact_diagnostics;
+    /// over the whole run: closest gaps, fewest and most particles seen
+    double                                    closest_gap_seen = -1., closest_wall_seen = -1.;
+    double                                    smallest_contact_cell = 0.;
+    unsigned int fewest_particles = std::numeric_limits<unsigned int>::max(), most_particles = 0;
     double                                    phi_l1_error = -1.;
     Postprocess::FieldOutput<dim>             field_output;
     Postprocess::FlowVerification<dim>        verification;

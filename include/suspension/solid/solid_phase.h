@@ -66,6 +66,12 @@ namespace Suspension::Solid
   public:
     static constexpr unsigned int n_B = dim * (dim + 1) / 2;
 
+    /// True if add() contributes anything (a stress or a body force).
+    bool pushes_fluid() const
+    {
+      return fe.n_components() > 1 || body_force != nullptr;
+    }
+
     SolidPhase(const Parameters::All &parameters,
                const parallel::distributed::Triangulation<dim> &tria);
 
@@ -140,6 +146,7 @@ namespace Suspension::Solid
     VectorType             solution, stage, stage_rhs, u0, u1, u_stage;
     double                 initial_volume = 0., time = 0.;
     mutable std::unique_ptr<FEValues<dim>> stress_values;
+    std::unique_ptr<Function<dim>>         body_force; // null: none
     std::unique_ptr<parallel::distributed::SolutionTransfer<dim, VectorType>> transfer;
   };
 } // namespace Suspension::Solid
