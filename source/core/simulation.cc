@@ -172,9 +172,13 @@ namespace Suspension
           next = std::min(ts.maximum_time_step, 0.9 * ts.cfl / d.max_speed_over_h);
       }
     // The explicit elastic stress: an elastic wave may not cross a cell.
+    // Stretched material is stiffer: the increment of G (B - I) under a
+    // velocity gradient is G (grad u B + B grad u^T), so the wave speed is
+    // sqrt(G lambda_max(B) / rho).
     if (solid && parameters.solid.elastic() && !prescribed_velocity)
       next = std::min(next, parameters.solid.elastic_number * smallest_cell_size /
-                              std::sqrt(parameters.solid.shear_modulus /
+                              std::sqrt(parameters.solid.shear_modulus *
+                                        std::max(1., solid_diagnostics.max_eigenvalue_B) /
                                         parameters.material.density));
     // A collapsing step means the flow blew up without (yet) a NaN.
     if (next < 1e-6 * ts.time_step)

@@ -288,7 +288,7 @@ namespace Suspension::Solid
     const unsigned int nc = fe.n_components();
     Point<dim>         worst;
     std::vector<Vector<double>> values(quadrature.size(), Vector<double>(nc));
-    double volume = 0., lo = 1e300, hi = -1e300, det_min = 1e300, eig_min = 1e300;
+    double volume = 0., lo = 1e300, hi = -1e300, det_min = 1e300, eig_min = 1e300, eig_max = 1.;
     std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
@@ -308,6 +308,8 @@ namespace Suspension::Solid
                     B[SymmetricTensor<2, dim>::unrolled_to_component_indices(c)] = values[q][1 + c];
                   det_min = std::min(det_min, determinant(B));
                   const double smallest = smallest_eigenvalue(B);
+                  // exact in 2D, an upper bound in 3D (the others are >= smallest)
+                  eig_max = std::max(eig_max, trace(B) - (dim - 1) * smallest);
                   if (smallest < eig_min || !std::isfinite(smallest))
                     {
                       eig_min = smallest;
@@ -334,6 +336,7 @@ namespace Suspension::Solid
         d.min_det_B = Utilities::MPI::min(det_min, comm);
         const auto m = Utilities::MPI::min_max_avg(eig_min, comm);
         d.min_eigenvalue_B = m.min;
+        d.max_eigenvalue_B = Utilities::MPI::max(eig_max, comm);
         const Point<dim> where = Utilities::MPI::broadcast(comm, worst, m.min_index);
         for (unsigned int c = 0; c < dim; ++c)
           d.worst_B_location[c] = where[c];

@@ -25,6 +25,7 @@ namespace Suspension::Solid
     double       min_phi = 0., max_phi = 0.;
     unsigned int limited_cells = 0, out_of_bound_means = 0, substeps = 0;
     double       min_det_B = 1., min_eigenvalue_B = 1.;
+    double       max_eigenvalue_B = 1.; // sets the elastic wave speed sqrt(G lambda / rho)
     std::array<double, 3> worst_B_location{}; // where min_eigenvalue_B is
   };
 
