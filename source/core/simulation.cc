@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
 namespace Suspension
@@ -65,6 +66,9 @@ namespace Suspension
       prescribed_velocity = make_function<dim>(parameters.fluid_solver.prescribed_velocity, dim);
     if (parameters.solid.enabled())
       solid = std::make_unique<Solid::SolidPhase<dim>>(parameters, triangulation);
+    if (parameters.statistics.enabled)
+      channel_statistics =
+        std::make_unique<Postprocess::ChannelStatistics<dim>>(parameters, communicator);
     if (!parameters.flow_driving.body_force.is_zero())
       body_force = std::make_unique<Fluid::BodyForce<dim>>(
         make_function<dim>(parameters.flow_driving.body_force, dim));
@@ -409,6 +413,8 @@ namespace Suspension
       return;
     std::ofstream stats(parameters.output.directory + "/statistics.txt");
     statistics.write_text(stats, TableHandler::table_with_separate_column_description);
+    if (channel_statistics)
+      channel_statistics->write(parameters.output.directory);
     if (!parameters.output.probe_points.empty())
       {
         std::ofstream out(parameters.output.directory + "/probes.txt");
@@ -421,6 +427,19 @@ namespace Suspension
             }
         copy.write_text(out, TableHandler::table_with_separate_column_description);
       }
+  }
+
+  template <int dim>
+  void Simulation<dim>::sample_statistics(const double driving_force)
+  {
+    TimerOutput::Scope scope(timer, "statistics");
+    std::optional<Postprocess::SolidFields<dim>> solid_fields;
+    if (solid)
+      solid_fields.emplace(Postprocess::SolidFields<dim>{
+        solid->get_dof_handler(), solid->get_solution(), parameters.solid.shear_modulus});
+    channel_statistics->sample(space, fluid.velocity(), fluid.time(), driving_force,
+                               solid_fields ? &*solid_fields : nullptr,
+                               nullptr); // contact force: wired in when it exists
   }
 
   template <int dim>
@@ -613,6 +632,8 @@ namespace Suspension
         add_statistics_row(report, diagnostics, dt, wall);
         if (solid)
           add_solid_statistics(solid_diagnostics);
+        if (channel_statistics && channel_statistics->due(fluid.time(), fluid.step_number()))
+          sample_statistics(report.driving_force);
         if (adaptor.enabled())
           {
             const MeshLevels levels = adaptor.levels(solid.get());
@@ -683,6 +704,9 @@ namespace Suspension
       report_solid();
     report_errors(fluid.time(), steady);
     report_verdicts(steady);
+    if (channel_statistics && pcout.is_active())
+      channel_statistics->print_summary(pcout.get_stream(), parameters.verification.tolerance,
+                                        !solid);
     if (parameters.verification.reference_data == Parameters::ReferenceData::ghia_re100)
       {
         const auto c = verification.compare_with_ghia(space, fluid.velocity());
