@@ -3,10 +3,12 @@
 #include <deal.II/base/symmetric_tensor.h>
 #include <deal.II/base/table_handler.h>
 #include <deal.II/fe/fe_values.h>
+#include <deal.II/lac/full_matrix.h>
 
 #include <suspension/postprocess/channel_statistics.h>
 
 #include <algorithm>
+#include <array>
 #include <cmath>
 #include <fstream>
 #include <iomanip>
@@ -19,9 +21,9 @@ namespace Suspension::Postprocess
 {
   namespace
   {
-    /// What a sample integrates per bin, and what is summed over samples
-    /// (the sample's bin mean of each; U, V, W are the plane means, so
-    /// <uv> - <UV> is the covariance of the fluctuations about them).
+    /// What a sample integrates per bin; the first n_stored are summed over
+    /// samples as the sample's bin means (uu..uv then hold the covariances
+    /// of the fluctuations, see fluctuations()). t = (y - y_bin) / (width/2).
     enum Quantity : unsigned int
     {
       volume, // integral (not a mean): |bin|
@@ -37,12 +39,18 @@ namespace Suspension::Postprocess
       viscous, // mu du/dy
       elastic, // G phi B_xy
       force_x, // contact force density
-      n_integrated,
-      UU = n_integrated, // products of plane means, per sample
-      VV,
-      WW,
-      UV,
-      n_stored
+      n_stored,
+      t1 = n_stored, // moments of t for the fit of the mean profile
+      t2,
+      t3,
+      t4,
+      ut1,
+      ut2,
+      vt1,
+      vt2,
+      wt1,
+      wt2,
+      n_integrated
     };
 
     enum Budget : unsigned int
@@ -55,6 +63,48 @@ namespace Suspension::Postprocess
       n_budget
     };
     const char *budget_names[n_budget] = {"viscous", "Reynolds", "elastic", "collision", "total"};
+
+    /// The covariances u'u', v'v', w'w', u'v' of one bin of one sample
+    /// (bin integrals I), the fluctuations taken about the least-squares
+    /// fit a + b t + c t^2 of each velocity component over the bin: its
+    /// plane mean as a function of y, so that the mean shear across a bin
+    /// is not counted as a fluctuation (exact for a parabolic profile).
+    /// Lower degrees where the bin holds too few rows of points.
+    std::array<double, 4> fluctuations(const double *I)
+    {
+      const double V       = I[volume];
+      const double T[5]    = {1., I[t1] / V, I[t2] / V, I[t3] / V, I[t4] / V};
+      const double C[3][3] = {{I[u] / V, I[ut1] / V, I[ut2] / V},
+                              {I[v] / V, I[vt1] / V, I[vt2] / V},
+                              {I[w] / V, I[wt1] / V, I[wt2] / V}};
+      // fit coefficients a_f = M^{-1} c_f, M_ij = <t^(i+j)>
+      unsigned int       n = 3;
+      FullMatrix<double> M;
+      for (;; --n)
+        {
+          M.reinit(n, n);
+          for (unsigned int i = 0; i < n; ++i)
+            for (unsigned int j = 0; j < n; ++j)
+              M(i, j) = T[i + j];
+          if (n == 1 || M.determinant() > 1e-10)
+            break;
+        }
+      M.gauss_jordan();
+      double a[3][3] = {};
+      for (unsigned int f = 0; f < 3; ++f)
+        for (unsigned int i = 0; i < n; ++i)
+          for (unsigned int j = 0; j < n; ++j)
+            a[f][i] += M(i, j) * C[f][j];
+      const auto residual = [&](const unsigned int product, const unsigned int f,
+                                const unsigned int g) {
+        double fitted = 0.;
+        for (unsigned int i = 0; i < n; ++i)
+          fitted += a[f][i] * C[g][i];
+        return I[product] / V - fitted;
+      };
+      return {{std::max(0., residual(uu, 0, 0)), std::max(0., residual(vv, 1, 1)),
+              std::max(0., residual(ww, 2, 2)), residual(uv, 0, 1)}};
+    }
 
     /// Rounded for the screen, without a negative zero.
     double rounded(const double x, const int digits)
@@ -108,6 +158,7 @@ namespace Suspension::Postprocess
     constexpr unsigned int Y = dim - 1, Z = 1;
     const double           mu = parameters.material.viscosity;
     const double           G  = solid ? solid->shear_modulus : 0.;
+    const double           width = 2. * h / n_bins;
 
     const QGauss<dim> quadrature(space.fe_velocity.degree + 1);
     const unsigned int n_q = quadrature.size();
@@ -157,15 +208,27 @@ namespace Suspension::Postprocess
           for (unsigned int q = 0; q < n_q; ++q)
             {
               const double yq = fe_u.quadrature_point(q)[Y];
-              const auto   k  = static_cast<unsigned int>(std::clamp(
-                std::floor((yq + h) / (2. * h) * n_bins), 0., double(n_bins - 1)));
+              const auto   k  = static_cast<unsigned int>(
+                std::clamp(std::floor((yq + h) / width), 0., double(n_bins - 1)));
               double      *I  = &local[k * n_integrated];
               const double dV = fe_u.JxW(q);
               const auto  &U  = u_q[q];
               const auto  &gU = grad_u_q[q];
               const double wq = dim == 3 ? U[Z] : 0.;
+              const double t  = (yq + h) / width - k - 0.5; // in [-1/2, 1/2]
+              const double t_ = 2. * t;
               I[volume] += dV;
               I[y] += yq * dV;
+              I[t1] += t_ * dV;
+              I[t2] += t_ * t_ * dV;
+              I[t3] += t_ * t_ * t_ * dV;
+              I[t4] += t_ * t_ * t_ * t_ * dV;
+              I[ut1] += U[0] * t_ * dV;
+              I[ut2] += U[0] * t_ * t_ * dV;
+              I[vt1] += U[Y] * t_ * dV;
+              I[vt2] += U[Y] * t_ * t_ * dV;
+              I[wt1] += wq * t_ * dV;
+              I[wt2] += wq * t_ * t_ * dV;
               I[u] += U[0] * dV;
               I[v] += U[Y] * dV;
               I[w] += wq * dV;
@@ -209,12 +272,15 @@ namespace Suspension::Postprocess
         auto         &m = means[k];
         m[volume]       = I[volume];
         total_volume += I[volume];
-        for (unsigned int c = y; c < n_integrated; ++c)
-          m[c] = I[volume] > 0. ? I[c] / I[volume] : 0.;
-        m[UU] = m[u] * m[u];
-        m[VV] = m[v] * m[v];
-        m[WW] = m[w] * m[w];
-        m[UV] = m[u] * m[v];
+        if (I[volume] <= 0.)
+          continue;
+        for (unsigned int c = y; c < n_stored; ++c)
+          m[c] = I[c] / I[volume];
+        const auto f = fluctuations(I);
+        m[uu]        = f[0];
+        m[vv]        = f[1];
+        m[ww]        = f[2];
+        m[uv]        = f[3];
         for (unsigned int c = 0; c < n_stored; ++c)
           sums[k][c] += m[c];
       }
@@ -251,7 +317,7 @@ namespace Suspension::Postprocess
       }
     const auto stress = [&](const unsigned int k, const unsigned int b) {
       const double visc = m[k][viscous];
-      const double re   = -rho * (m[k][uv] - m[k][UV]);
+      const double re   = -rho * m[k][uv];
       const double el   = m[k][elastic];
       const double coll = collision[k];
       switch (b)
@@ -276,17 +342,15 @@ namespace Suspension::Postprocess
         const unsigned int r    = n_bins - 1 - k; // the mirror bin
         const auto         even = [&](const unsigned int c) { return 0.5 * (m[k][c] + m[r][c]); };
         const auto         odd  = [&](const unsigned int c) { return 0.5 * (m[k][c] - m[r][c]); };
-        const auto rms = [&](const unsigned int c, const unsigned int C) {
-          return std::sqrt(std::max(0., even(c) - even(C)));
-        };
+        const auto rms  = [&](const unsigned int c) { return std::sqrt(std::max(0., even(c))); };
         p.volume.push_back(even(volume));
         p.y.push_back(odd(y));
         p.u.push_back(even(u));
         p.v.push_back(odd(v));
         p.phi.push_back(even(phi));
-        p.u_rms.push_back(rms(uu, UU));
-        p.v_rms.push_back(rms(vv, VV));
-        p.w_rms.push_back(rms(ww, WW));
+        p.u_rms.push_back(rms(uu));
+        p.v_rms.push_back(rms(vv));
+        p.w_rms.push_back(rms(ww));
         for (unsigned int b = 0; b < n_budget; ++b)
           p.stress[b].push_back(0.5 * (stress(k, b) - stress(r, b)));
         p.linear.push_back(-Pi * p.y.back());
@@ -414,9 +478,10 @@ namespace Suspension::Postprocess
         << " to " << rounded(last_time, 6) << std::endl;
     out << "  mu_eff/mu = " << plus_minus(viscosity_ratio) << ", N1 = " << plus_minus(n1)
         << ", N2 = " << plus_minus(n2) << std::endl;
-    out << "  shear-stress budget (half-channel mean, % of total):";
+    out << "  shear-stress budget (half-channel mean):";
     for (unsigned int b = 0; b < b_total; ++b)
-      out << " " << budget_names[b] << " " << fixed(100. * budget[b].mean / total, 2);
+      out << (b > 0 ? ", " : " ") << budget_names[b] << " "
+          << fixed(100. * budget[b].mean / total, 2) << " %";
     out << std::endl;
     const double deviation = linear_deviation(p);
     out << "  total shear stress linear to " << std::scientific << std::setprecision(1)

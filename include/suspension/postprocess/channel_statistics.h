@@ -48,8 +48,13 @@ namespace Suspension::Postprocess
    * quadrature (velocity degree + 1 points per direction) adds its weight
    * to the slab that holds its y. The plane mean of a sample is
    *   [f]_s(y_k) = int_{bin k} f dV / |bin k|,
-   * the fluctuation about it f' = f - [f]_s, and <.> the mean over
-   * samples of [.]_s. Profiles are folded onto the lower half: even
+   * and <.> the mean over samples of [.]_s. Velocity fluctuations are
+   * taken about the sample's plane mean as a function of y, the
+   * least-squares fit U_s(y) = a + b t + c t^2 over each bin (t the
+   * position in the bin): u' = u - U_s(y), so that the mean shear across
+   * a bin is not counted as a fluctuation (exact for a parabolic profile;
+   * lower degrees where a bin holds fewer than three rows of points).
+   * Profiles are folded onto the lower half: even
    * quantities as (f(y) + f(-y)) / 2, odd ones (v and the shear stresses)
    * as (f(y) - f(-y)) / 2, reported at the mean y of the bin's points.
    *
@@ -128,8 +133,8 @@ namespace Suspension::Postprocess
     const double           h;
     const unsigned int     n_bins;
 
-    /// Per bin, sums over samples of the sample's plane means
-    /// (see the enum in the .cc file for the order).
+    /// Per bin, sums over samples of the sample's plane means and
+    /// fluctuation covariances (see the enum in the .cc file).
     std::vector<std::vector<double>> sums;
     unsigned int                     n_sampled  = 0;
     double                           first_time = 0., last_time = 0.;
