@@ -138,6 +138,8 @@ namespace Suspension::Postprocess
     std::vector<std::vector<double>> sums;
     unsigned int                     n_sampled  = 0;
     double                           first_time = 0., last_time = 0.;
+    /// most cells cut by a bin boundary in any sample (0: bins fit the mesh)
+    unsigned long long               straddling_cells = 0;
     RunningMean                      driving, viscosity_ratio, n1, n2;
     /// per-sample folded half-channel budget: viscous, Reynolds, elastic,
     /// collision, total
