@@ -870,9 +870,10 @@ namespace Suspension::Parameters
     prm.declare_entry("Number of bins", std::to_string(d.n_bins),
                       Patterns::Integer(2),
                       "Wall-normal bins of equal width across the whole "
-                      "channel (-h to h); an even number keeps the two halves "
-                      "apart. Best a divisor of the number of cells across "
-                      "the channel, so that no cell straddles two bins.");
+                      "channel (-h to h); even, so that the two halves fold "
+                      "onto each other bin by bin. Best a divisor of the "
+                      "number of cells across the channel, so that no cell "
+                      "straddles two bins (the run notes it if one does).");
     prm.leave_subsection();
   }
 
