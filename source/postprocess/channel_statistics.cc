@@ -194,10 +194,10 @@ namespace Suspension::Postprocess
         {
           {
             double y_min = cell->vertex(0)[Y], y_max = y_min;
-            for (const unsigned int v : cell->vertex_indices())
+            for (const unsigned int i : cell->vertex_indices())
               {
-                y_min = std::min(y_min, cell->vertex(v)[Y]);
-                y_max = std::max(y_max, cell->vertex(v)[Y]);
+                y_min = std::min(y_min, cell->vertex(i)[Y]);
+                y_max = std::max(y_max, cell->vertex(i)[Y]);
               }
             if (std::ceil((y_max + h) / width - 1e-8) - std::floor((y_min + h) / width + 1e-8) > 1.)
               local[n_bins * n_integrated + 3] += 1.;
@@ -212,6 +212,7 @@ namespace Suspension::Postprocess
             }
           if (collision)
             {
+              // forces only: the stress is ignored (has_stress() is false)
               std::fill(force.begin(), force.end(), Tensor<1, dim>());
               collision->add(cell, fe_u.get_quadrature_points(), quadrature.get_points(), time,
                              force, stress);
