@@ -885,6 +885,47 @@ namespace Suspension::Parameters
       }
   }
 
+  // -------------------------------------------------------------- Statistics
+  void Statistics::declare(ParameterHandler &prm)
+  {
+    const Statistics d;
+    prm.enter_subsection("Statistics");
+    prm.declare_entry("Enabled", d.enabled ? "true" : "false", Patterns::Bool(),
+                      "Accumulate channel statistics (wall-normal profiles, "
+                      "effective viscosity, N1, N2, shear-stress budget) and "
+                      "write profiles.txt and rheology.txt to the output "
+                      "directory. Channel geometry only.");
+    prm.declare_entry("Start time", std::to_string(d.start_time),
+                      Patterns::Double(0.),
+                      "Samples are taken from this time on (after the "
+                      "start-up transient).");
+    prm.declare_entry("Sample interval", std::to_string(d.sample_interval),
+                      Patterns::Integer(1),
+                      "Take a sample every this many time steps.");
+    prm.declare_entry("Number of bins", std::to_string(d.n_bins),
+                      Patterns::Integer(2),
+                      "Wall-normal bins of equal width across the whole "
+                      "channel (-h to h); even, so that the two halves fold "
+                      "onto each other bin by bin. Best a divisor of the "
+                      "number of cells across the channel, so that no cell "
+                      "straddles two bins (the run notes it if one does).");
+    prm.leave_subsection();
+  }
+
+  void Statistics::parse(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Statistics");
+    enabled         = prm.get_bool("Enabled");
+    start_time      = prm.get_double("Start time");
+    sample_interval = prm.get_integer("Sample interval");
+    n_bins          = prm.get_integer("Number of bins");
+    prm.leave_subsection();
+    if (enabled && n_bins % 2 != 0)
+      throw InputError("Statistics/Number of bins",
+                       "must be even, so that the two channel halves fold "
+                       "onto each other bin by bin");
+  }
+
   // ------------------------------------------------------------ Verification
   void Verification::declare(ParameterHandler &prm, const unsigned int dim)
   {
@@ -1061,6 +1102,7 @@ namespace Suspension::Parameters
     Solid::declare(prm, dim);
     TimeStepping::declare(prm);
     Output::declare(prm);
+    Statistics::declare(prm);
     Verification::declare(prm, dim);
   }
 
@@ -1078,6 +1120,7 @@ namespace Suspension::Parameters
     solid.parse(prm, dim);
     time_stepping.parse(prm);
     output.parse(prm, dim);
+    statistics.parse(prm);
     verification.parse(prm, dim);
 
     if (geometry.type == GeometryType::channel)
@@ -1096,6 +1139,10 @@ namespace Suspension::Parameters
             throw InputError("Geometry/Subdivisions",
                              "a periodic direction needs at least 2 base cells");
         }
+    if (statistics.enabled && geometry.type != GeometryType::channel)
+      throw InputError("Statistics/Enabled",
+                       "channel statistics need 'Geometry/Type = channel' "
+                       "(walls at -h and +h, periodic otherwise)");
     if (solid.initial_fraction == InitialFraction::random_particles)
       seed_solid(dim);
     resolve_contact_force();

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iomanip>
+#include <optional>
 #include <sstream>
 
 namespace Suspension
@@ -68,6 +69,9 @@ namespace Suspension
     if (parameters.solid.contact.enabled)
       contact = std::make_unique<Solid::ContactForce<dim>>(parameters, scene.no_slip_walls(),
                                                            scene.periods());
+    if (parameters.statistics.enabled)
+      channel_statistics =
+        std::make_unique<Postprocess::ChannelStatistics<dim>>(parameters, communicator);
     if (!parameters.flow_driving.body_force.is_zero())
       body_force = std::make_unique<Fluid::BodyForce<dim>>(
         make_function<dim>(parameters.flow_driving.body_force, dim));
@@ -477,6 +481,8 @@ namespace Suspension
       return;
     std::ofstream stats(parameters.output.directory + "/statistics.txt");
     statistics.write_text(stats, TableHandler::table_with_separate_column_description);
+    if (channel_statistics)
+      channel_statistics->write(parameters.output.directory);
     if (!parameters.output.probe_points.empty())
       {
         std::ofstream out(parameters.output.directory + "/probes.txt");
@@ -489,6 +495,19 @@ namespace Suspension
             }
         copy.write_text(out, TableHandler::table_with_separate_column_description);
       }
+  }
+
+  template <int dim>
+  void Simulation<dim>::sample_statistics(const double driving_force)
+  {
+    TimerOutput::Scope scope(timer, "statistics");
+    std::optional<Postprocess::SolidFields<dim>> solid_fields;
+    if (solid)
+      solid_fields.emplace(Postprocess::SolidFields<dim>{
+        solid->get_dof_handler(), solid->get_solution(), parameters.solid.shear_modulus});
+    channel_statistics->sample(space, fluid.velocity(), fluid.time(), driving_force,
+                               solid_fields ? &*solid_fields : nullptr,
+                               contact.get());
   }
 
   template <int dim>
@@ -686,6 +705,8 @@ namespace Suspension
           add_solid_statistics(solid_diagnostics);
         if (contact)
           add_contact_statistics();
+        if (channel_statistics && channel_statistics->due(fluid.time(), fluid.step_number()))
+          sample_statistics(report.driving_force);
         if (adaptor.enabled())
           {
             const MeshLevels levels = adaptor.levels(solid.get());
@@ -758,6 +779,9 @@ namespace Suspension
       report_contact();
     report_errors(fluid.time(), steady);
     report_verdicts(steady);
+    if (channel_statistics && pcout.is_active())
+      channel_statistics->print_summary(pcout.get_stream(), parameters.verification.tolerance,
+                                        !solid);
     if (parameters.verification.reference_data == Parameters::ReferenceData::ghia_re100)
       {
         const auto c = verification.compare_with_ghia(space, fluid.velocity());

@@ -33,6 +33,7 @@ expect unpaired_periodic  "$dir/unpaired_periodic.prm" -- "unpaired_periodic.prm
 expect bad_dimension      "$dir/bad_dimension.prm"     -- "bad_dimension.prm" "Dimension"
 expect missing_file       "$dir/no_such_file.prm"      -- "no_such_file.prm" "cannot read"
 expect too_dense          "$dir/too_dense.prm"         -- "too_dense.prm" "Solid/Seeding/Volume fraction" "could place only"
+expect statistics_box     "$dir/statistics_not_channel.prm" -- "statistics_not_channel.prm" "Statistics/Enabled" "channel"
 expect no_argument                                     -- "no parameter file"
 
 echo "$failures failure(s)"

@@ -277,6 +277,19 @@ namespace Suspension::Parameters
     void        parse(ParameterHandler &prm, unsigned int dim);
   };
 
+  /// Channel statistics (Postprocess::ChannelStatistics): wall-normal
+  /// profiles and bulk rheology averaged over samples in time.
+  struct Statistics
+  {
+    bool         enabled         = false;
+    double       start_time      = 0.;
+    unsigned int sample_interval = 10; // steps
+    unsigned int n_bins          = 64; // across the whole channel
+
+    static void declare(ParameterHandler &prm);
+    void        parse(ParameterHandler &prm);
+  };
+
   enum class ExactSolutionType
   {
     none,
@@ -332,6 +345,7 @@ namespace Suspension::Parameters
     Solid              solid;
     TimeStepping       time_stepping;
     Output             output;
+    Statistics         statistics;
     Verification       verification;
 
     static void declare(ParameterHandler &prm, unsigned int dim);

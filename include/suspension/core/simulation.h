@@ -11,6 +11,7 @@
 #include <suspension/fluid/fluid_space.h>
 #include <suspension/fluid/projection_scheme.h>
 #include <suspension/mesh/mesh_adaptor.h>
+#include <suspension/postprocess/channel_statistics.h>
 #include <suspension/postprocess/field_output.h>
 #include <suspension/postprocess/flow_verification.h>
 #include <suspension/solid/contact_force.h>
@@ -70,6 +71,7 @@ namespace Suspension
     void   report_verdicts(bool steady);
     void   print_progress(double dt, const Fluid::FlowDiagnostics &d, double elapsed) const;
     void   write_tables() const;
+    void   sample_statistics(double driving_force);
 
     const Parameters::All                    &parameters;
     MPI_Comm                                  communicator;
@@ -94,6 +96,7 @@ namespace Suspension
     double                                    phi_l1_error = -1.;
     Postprocess::FieldOutput<dim>             field_output;
     Postprocess::FlowVerification<dim>        verification;
+    std::unique_ptr<Postprocess::ChannelStatistics<dim>> channel_statistics;
     TableHandler                              statistics, probes;
     Postprocess::FlowErrors                   last_errors;
     std::vector<std::pair<double, Postprocess::FlowErrors>> error_history;
