@@ -164,6 +164,25 @@ namespace Suspension
   }
 
   template <int dim>
+  bool MeshAdaptor<dim>::flag_periodic_hanging_faces()
+  {
+    unsigned int flagged = 0;
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          cell->clear_coarsen_flag();
+          for (const unsigned int f : cell->face_indices())
+            if (cell->has_periodic_neighbor(f) && !cell->periodic_neighbor(f)->is_active())
+              {
+                cell->set_refine_flag();
+                ++flagged;
+                break;
+              }
+        }
+    return Utilities::MPI::sum(flagged, triangulation.get_communicator()) > 0;
+  }
+
+  template <int dim>
   MeshLevels MeshAdaptor<dim>::levels(const Solid::SolidPhase<dim> *solid) const
   {
     const MPI_Comm comm = triangulation.get_communicator();

@@ -54,6 +54,7 @@ namespace Suspension
     void   setup();
     void   create_initial_mesh();
     bool   adapt_mesh();
+    void   change_mesh_with_fields();
     double choose_time_step(double dt, double time, const Fluid::FlowDiagnostics &d) const;
     bool   output_due(double time, double dt) const;
     void   write_output();

@@ -69,6 +69,14 @@ namespace Suspension
 
     MeshLevels levels(const Solid::SolidPhase<dim> *solid) const;
 
+    /// Flags for refinement every locally owned cell whose periodic
+    /// neighbour is finer; true if any rank flagged one. Called after each
+    /// refinement until it returns false, so that no face across a periodic
+    /// boundary has a hanging node: deal.II 9.4's MatrixFree gets the DG
+    /// face pairs wrong there (dealii/dealii#8905), which corrupted B in a
+    /// particle straddling the periodic boundary.
+    bool flag_periodic_hanging_faces();
+
   private:
     /// Widens `band` (per active cell) by one face neighbour, `layers` times.
     void dilate(std::vector<unsigned char> &band, unsigned int layers) const;
