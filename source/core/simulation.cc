@@ -117,9 +117,11 @@ namespace Suspension
   bool Simulation<dim>::adapt_mesh()
   {
     TimerOutput::Scope scope(timer, "mesh adaptation");
+    TimerOutput::Scope flagging(timer, "mesh: flag cells");
     if (!adaptor.flag(solid.get(), space, prescribed_velocity ? nullptr : &fluid.velocity(),
                       fluid.time()))
       return false;
+    flagging.stop();
     do
       change_mesh_with_fields();
     while (adaptor.flag_periodic_hanging_faces());
@@ -130,16 +132,28 @@ namespace Suspension
   template <int dim>
   void Simulation<dim>::change_mesh_with_fields()
   {
-    fluid.prepare_for_mesh_change();
+    {
+      TimerOutput::Scope scope(timer, "mesh: refine and repartition");
+      fluid.prepare_for_mesh_change();
+      if (solid)
+        solid->prepare_for_mesh_change();
+      triangulation.execute_coarsening_and_refinement();
+    }
+    {
+      TimerOutput::Scope scope(timer, "mesh: DoFs, constraints, matrices");
+      space.setup(scene);
+      if (!prescribed_velocity)
+        operators.reinit(space);
+    }
+    {
+      TimerOutput::Scope scope(timer, "mesh: transfer fluid fields");
+      fluid.finish_mesh_change(prescribed_velocity.get());
+    }
     if (solid)
-      solid->prepare_for_mesh_change();
-    triangulation.execute_coarsening_and_refinement();
-    space.setup(scene);
-    if (!prescribed_velocity)
-      operators.reinit(space);
-    fluid.finish_mesh_change(prescribed_velocity.get());
-    if (solid)
-      solid->finish_mesh_change(space);
+      {
+        TimerOutput::Scope scope(timer, "mesh: transfer solid fields");
+        solid->finish_mesh_change(space);
+      }
     smallest_cell_size = smallest_cell();
   }
 

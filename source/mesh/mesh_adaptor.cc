@@ -154,13 +154,49 @@ namespace Suspension
           else if (level > t)
             cell->set_coarsen_flag();
         }
-    triangulation.prepare_coarsening_and_refinement();
+    // p4est's 2:1 balance may add flags on one side only: agree again
+    for (unsigned int pass = 0; pass < 3; ++pass)
+      {
+        keep_periodic_faces_conforming();
+        triangulation.prepare_coarsening_and_refinement();
+      }
 
     unsigned int flagged = 0;
     for (const auto &cell : triangulation.active_cell_iterators())
       if (cell->is_locally_owned() && (cell->refine_flag_set() || cell->coarsen_flag_set()))
         ++flagged;
     return Utilities::MPI::sum(flagged, triangulation.get_communicator()) > 0;
+  }
+
+  template <int dim>
+  void MeshAdaptor<dim>::keep_periodic_faces_conforming()
+  {
+    // Two cells facing each other across a periodic boundary move together:
+    // refine if the other side is finer or will refine, coarsen only if it
+    // coarsens too. Cells whose periodic neighbour is a ghost's or
+    // artificial are left to flag_periodic_hanging_faces().
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+        for (const unsigned int f : cell->face_indices())
+          if (cell->has_periodic_neighbor(f))
+            {
+              const auto other = cell->periodic_neighbor(f);
+              if (!other->is_active())
+                {
+                  cell->clear_coarsen_flag();
+                  cell->set_refine_flag();
+                }
+              else if (other->is_locally_owned() && other->level() == cell->level())
+                {
+                  if (other->refine_flag_set())
+                    {
+                      cell->clear_coarsen_flag();
+                      cell->set_refine_flag();
+                    }
+                  else if (!other->coarsen_flag_set())
+                    cell->clear_coarsen_flag();
+                }
+            }
   }
 
   template <int dim>

@@ -78,6 +78,9 @@ namespace Suspension
     bool flag_periodic_hanging_faces();
 
   private:
+    /// Makes the flags of cells facing each other across periodic faces
+    /// agree (see flag_periodic_hanging_faces()).
+    void keep_periodic_faces_conforming();
     /// Widens `band` (per active cell) by one face neighbour, `layers` times.
     void dilate(std::vector<unsigned char> &band, unsigned int layers) const;
 
