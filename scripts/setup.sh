@@ -18,12 +18,13 @@ if [ -n "$missing" ]; then
   apt-get install -y -qq --no-install-recommends $missing > /dev/null
 fi
 
+# cores, counted before OMP_NUM_THREADS is set (nproc obeys it)
+jobs=$(getconf _NPROCESSORS_ONLN)
 # Open MPI refuses to run as root unless told that it is wanted.
 export OMPI_ALLOW_RUN_AS_ROOT=1 OMPI_ALLOW_RUN_AS_ROOT_CONFIRM=1
 # one MPI rank per core, no hidden threads inside the BLAS
 export OMP_NUM_THREADS=1
 
-jobs=$(nproc)
 mkdir -p "$root/build"
 if [ ! -f "$root/build/CMakeCache.txt" ]; then
   echo "== configuring"
