@@ -118,6 +118,12 @@ namespace Suspension
   template <int dim>
   void run_study(const Parameters::All &parameters, MPI_Comm communicator)
   {
+    if (parameters.checkpoint.resume &&
+        (!parameters.verification.sweep_entry.empty() ||
+         std::max(parameters.verification.refinement_cycles,
+                  parameters.verification.time_step_cycles) > 1))
+      throw std::runtime_error("--resume continues a single run; this file asks for a sweep "
+                               "or refinement / time-step cycles");
     if (!parameters.verification.sweep_entry.empty())
       return run_sweep<dim>(parameters, communicator);
 

@@ -7,6 +7,7 @@
 #include <suspension/fluid/fluid_operators.h>
 #include <suspension/solid/solid_phase.h>
 
+#include <iosfwd>
 #include <memory>
 #include <vector>
 
@@ -68,6 +69,10 @@ namespace Suspension
               double                         time);
 
     MeshLevels levels(const Solid::SolidPhase<dim> *solid) const;
+
+    /// The counters due() keeps (text, full precision; checkpoints).
+    void save(std::ostream &out) const;
+    void load(std::istream &in);
 
   private:
     /// Widens `band` (per active cell) by one face neighbour, `layers` times.
