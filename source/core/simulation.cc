@@ -125,21 +125,27 @@ namespace Suspension
     const std::string path  = checkpoint.find();
     const std::string state = checkpoint.read_state();
     scene.create_coarse_mesh(triangulation);
-    // before p4est reads a mesh it cannot hold
-    std::istringstream header(state);
-    std::string        tag;
-    unsigned int       version = 0, d = 0, ranks = 0;
-    unsigned long long coarse_cells = 0;
-    header >> tag >> version >> d >> ranks >> coarse_cells;
-    if (tag != "suspension-checkpoint" || version != 1)
+    // Before p4est reads a mesh it cannot hold, and before fields are read
+    // into elements of another size: the header (checkpoint_header()) must
+    // match but for the rank count.
+    const auto without_ranks = [](const std::string &header) {
+      std::istringstream in(header);
+      std::string        word, result;
+      for (unsigned int i = 0; in >> word; ++i)
+        if (i == 2 || i > 3) // not the tag, the format or the rank count
+          result += (result.empty() ? "" : " ") + word;
+      return result;
+    };
+    const std::string saved = state.substr(0, state.find('\n'));
+    if (saved.rfind("suspension-checkpoint 1 ", 0) != 0)
       throw std::runtime_error("--resume: '" + path + "/state.txt' is not a checkpoint of "
                                "this version of suspension");
-    if (d != dim || coarse_cells != triangulation.n_cells(0))
-      throw std::runtime_error(
-        "--resume: the checkpoint in '" + path + "' is of a " + std::to_string(d) + "D mesh of " +
-        std::to_string(coarse_cells) + " coarse cells, the parameter file gives a " +
-        std::to_string(dim) + "D mesh of " + std::to_string(triangulation.n_cells(0)) +
-        ": resume with the file the checkpoint was written with");
+    if (without_ranks(saved) != without_ranks(checkpoint_header()))
+      throw std::runtime_error("--resume: the checkpoint in '" + path + "' was written for '" +
+                               without_ranks(saved) + "', the parameter file gives '" +
+                               without_ranks(checkpoint_header()) +
+                               "' (dimension, coarse cells, elements): resume with the file "
+                               "the checkpoint was written with");
     checkpoint.load_mesh(triangulation);
     space.setup(scene);
     if (!prescribed_velocity)
@@ -186,6 +192,17 @@ namespace Suspension
   } // namespace
 
   template <int dim>
+  std::string Simulation<dim>::checkpoint_header() const
+  {
+    std::ostringstream line;
+    line << "suspension-checkpoint 1 " << dim << "D " << Utilities::MPI::n_mpi_processes(communicator)
+         << " " << triangulation.n_cells(0) << "_coarse_cells " << space.fe_velocity.get_name()
+         << " " << space.fe_pressure.get_name() << " "
+         << (solid ? solid->get_fe().get_name() : std::string("no_solid"));
+    return line.str();
+  }
+
+  template <int dim>
   std::string Simulation<dim>::save_state(const double dt, const double wall_time) const
   {
     const auto part = [](const auto &object) {
@@ -199,8 +216,7 @@ namespace Suspension
 
     // a line resume() reads before the mesh, then a boost archive
     std::ostringstream out;
-    out << "suspension-checkpoint 1 " << dim << " " << Utilities::MPI::n_mpi_processes(communicator)
-        << " " << triangulation.n_cells(0) << "\n";
+    out << checkpoint_header() << "\n";
     {
       boost::archive::text_oarchive archive(out);
       archive << sizes(triangulation, space, solid.get());

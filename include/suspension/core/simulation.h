@@ -63,6 +63,10 @@ namespace Suspension
     std::string save_state(double dt, double wall_time) const;
     /// Returns dt.
     double load_state(const std::string &state, const std::string &path);
+    /// The first line of a checkpoint's state: what a resumed run must
+    /// match before p4est reads the mesh (dimension, coarse cells, finite
+    /// elements), and the rank count it was written on.
+    std::string checkpoint_header() const;
     void   create_initial_mesh();
     bool   adapt_mesh();
     double choose_time_step(double dt, double time, const Fluid::FlowDiagnostics &d) const;

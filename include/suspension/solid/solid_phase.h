@@ -141,6 +141,7 @@ namespace Suspension::Solid
              std::vector<SymmetricTensor<2, dim>> &stress) const override;
 
     const DoFHandler<dim> &get_dof_handler() const { return dof_handler; }
+    const FiniteElement<dim> &get_fe() const { return fe; }
     const VectorType      &get_solution() const { return solution; }
     std::vector<std::string> component_names() const;
 
