@@ -10,7 +10,7 @@
 # and are left out, as are the wall times.
 # usage: check.sh SUSPENSION MPIEXEC THIS_DIRECTORY [RANKS [RESUME_RANKS]]
 exe="$1"; mpiexec="$2"; dir="$3"; ranks="${4:-1}"; resume_ranks="${5:-$ranks}"
-K=12; M=20
+K=${K:-12}; M=${M:-20} # checkpoint every K steps, stop after M
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 cd "$work" || exit 1
 
