@@ -11,11 +11,17 @@
 #include <iostream>
 #include <regex>
 #include <string>
+#include <utility>
+#include <vector>
 
 namespace
 {
   const char *usage =
-    "usage: suspension FILE.prm            run the scene described in FILE.prm\n"
+    "usage: suspension FILE.prm [--resume] [--set 'Section/Entry=value']...\n"
+    "                                      run the scene described in FILE.prm;\n"
+    "                                      --resume: continue from the checkpoint in\n"
+    "                                      <Output directory>/checkpoint/ (same FILE.prm);\n"
+    "                                      --set: change one entry of FILE.prm\n"
     "       suspension --print-parameters [2|3] [--json]\n"
     "                                      every entry, its default and documentation\n"
     "       suspension --help              this text\n";
@@ -66,13 +72,28 @@ int main(int argc, char *argv[])
     return fail("unknown option '" + args[0] + "' (suspension --help for usage)");
 
   const std::string filename = args[0];
-  Parameters::All   parameters;
+  bool              resume   = false;
+  std::vector<std::pair<std::string, std::string>> overrides;
+  for (unsigned int i = 1; i < args.size(); ++i)
+    if (args[i] == "--resume")
+      resume = true;
+    else if (args[i] == "--set" && i + 1 < args.size() &&
+             args[i + 1].find('=') != std::string::npos)
+      {
+        const std::string &entry = args[++i];
+        overrides.emplace_back(entry.substr(0, entry.find('=')), entry.substr(entry.find('=') + 1));
+      }
+    else
+      return fail("unknown or incomplete option '" + args[i] + "' (suspension --help for usage)");
+
+  Parameters::All parameters;
   try
     {
       if (!std::ifstream(filename))
         return fail("cannot read parameter file '" + filename + "'");
       const unsigned int dim = Parameters::read_dimension(filename);
-      parameters             = Parameters::read(filename, dim);
+      parameters             = Parameters::read(filename, dim, overrides);
+      parameters.checkpoint.resume = resume;
     }
   catch (const Parameters::InputError &e)
     {

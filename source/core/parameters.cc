@@ -813,6 +813,33 @@ namespace Suspension::Parameters
     prm.leave_subsection();
   }
 
+  // -------------------------------------------------------------- Checkpoint
+  void Checkpoint::declare(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Checkpoint");
+    prm.declare_entry("Interval steps",
+                      "0",
+                      Patterns::Integer(0),
+                      "Write a checkpoint (mesh, fields, statistics, every "
+                      "scalar of the time loop) to <Output directory>/"
+                      "checkpoint/ every this many steps (0: off); "
+                      "`suspension FILE.prm --resume` continues from it.");
+    prm.declare_entry("Interval minutes",
+                      "0",
+                      Patterns::Double(0., Patterns::Double::max_double_value),
+                      "Also write one once this much wall time has passed "
+                      "since the start or the last checkpoint (0: off).");
+    prm.leave_subsection();
+  }
+
+  void Checkpoint::parse(ParameterHandler &prm)
+  {
+    prm.enter_subsection("Checkpoint");
+    interval_steps   = prm.get_integer("Interval steps");
+    interval_minutes = prm.get_double("Interval minutes");
+    prm.leave_subsection();
+  }
+
   // ------------------------------------------------------------------ Output
   void Output::declare(ParameterHandler &prm)
   {
@@ -1104,6 +1131,7 @@ namespace Suspension::Parameters
     Output::declare(prm);
     Statistics::declare(prm);
     Verification::declare(prm, dim);
+    Checkpoint::declare(prm);
   }
 
   void All::parse(ParameterHandler &prm, const unsigned int dim)
@@ -1122,6 +1150,7 @@ namespace Suspension::Parameters
     output.parse(prm, dim);
     statistics.parse(prm);
     verification.parse(prm, dim);
+    checkpoint.parse(prm);
 
     if (geometry.type == GeometryType::channel)
       for (unsigned int d = 0; d + 1 < dim; ++d)

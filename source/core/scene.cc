@@ -84,7 +84,7 @@ namespace Suspension
 
   template <int dim>
   void
-  Scene<dim>::create_mesh(parallel::distributed::Triangulation<dim> &tria) const
+  Scene<dim>::create_coarse_mesh(parallel::distributed::Triangulation<dim> &tria) const
   {
     GridGenerator::subdivided_hyper_rectangle(tria,
                                               parameters.geometry.subdivisions,
@@ -100,6 +100,13 @@ namespace Suspension
           GridTools::collect_periodic_faces(tria, 2 * d, 2 * d + 1, d, pairs);
         tria.add_periodicity(pairs);
       }
+  }
+
+  template <int dim>
+  void
+  Scene<dim>::create_mesh(parallel::distributed::Triangulation<dim> &tria) const
+  {
+    create_coarse_mesh(tria);
     tria.refine_global(parameters.mesh.global_refinements);
 
     if (!parameters.mesh.refinement_region.empty())

@@ -3,6 +3,7 @@
 #include <deal.II/base/function_parser.h>
 #include <deal.II/base/mpi.h>
 
+#include <suspension/core/checkpoint.h>
 #include <suspension/core/simulation.h>
 #include <suspension/core/study.h>
 
@@ -118,6 +119,14 @@ namespace Suspension
   template <int dim>
   void run_study(const Parameters::All &parameters, MPI_Comm communicator)
   {
+    if (parameters.checkpoint.resume &&
+        (!parameters.verification.sweep_entry.empty() ||
+         std::max(parameters.verification.refinement_cycles,
+                  parameters.verification.time_step_cycles) > 1))
+      throw std::runtime_error("--resume continues a single run; this file asks for a sweep "
+                               "or refinement / time-step cycles");
+    if (parameters.checkpoint.resume)
+      Checkpoint<dim>(parameters, communicator).find(); // a missing one: one line, nothing run
     if (!parameters.verification.sweep_entry.empty())
       return run_sweep<dim>(parameters, communicator);
 

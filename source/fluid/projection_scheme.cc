@@ -5,6 +5,10 @@
 
 #include <suspension/fluid/projection_scheme.h>
 
+#include <iomanip>
+#include <istream>
+#include <ostream>
+
 namespace Suspension::Fluid
 {
   template <int dim>
@@ -59,11 +63,13 @@ namespace Suspension::Fluid
   }
 
   template <int dim>
-  void ProjectionScheme<dim>::prepare_for_mesh_change()
+  void ProjectionScheme<dim>::attach_time_levels(const bool serialization)
   {
     const MPI_Comm comm = space.communicator();
     transfer_velocity_in.assign(2, VectorType());
-    transfer_pressure_in.assign(3, VectorType());
+    // a checkpoint also keeps Pi div u: the start of the next mass solve,
+    // so that the resumed run iterates as the uninterrupted one
+    transfer_pressure_in.assign(serialization ? 4 : 3, VectorType());
     for (auto &v : transfer_velocity_in)
       v.reinit(space.owned_velocity, space.relevant_velocity, comm);
     for (auto &v : transfer_pressure_in)
@@ -73,12 +79,80 @@ namespace Suspension::Fluid
     transfer_pressure_in[0] = p;
     transfer_pressure_in[1] = psi;
     transfer_pressure_in[2] = psi_old;
+    if (serialization)
+      transfer_pressure_in[3] = div_u;
     velocity_transfer = std::make_unique<Transfer>(space.dof_velocity);
     pressure_transfer = std::make_unique<Transfer>(space.dof_pressure);
-    velocity_transfer->prepare_for_coarsening_and_refinement(
-      {&transfer_velocity_in[0], &transfer_velocity_in[1]});
-    pressure_transfer->prepare_for_coarsening_and_refinement(
-      {&transfer_pressure_in[0], &transfer_pressure_in[1], &transfer_pressure_in[2]});
+    const std::vector<const VectorType *> velocities = {&transfer_velocity_in[0],
+                                                        &transfer_velocity_in[1]};
+    std::vector<const VectorType *> pressures;
+    for (const auto &v : transfer_pressure_in)
+      pressures.push_back(&v);
+    if (serialization)
+      {
+        velocity_transfer->prepare_for_serialization(velocities);
+        pressure_transfer->prepare_for_serialization(pressures);
+      }
+    else
+      {
+        velocity_transfer->prepare_for_coarsening_and_refinement(velocities);
+        pressure_transfer->prepare_for_coarsening_and_refinement(pressures);
+      }
+  }
+
+  template <int dim>
+  void ProjectionScheme<dim>::prepare_for_mesh_change()
+  {
+    attach_time_levels(false);
+  }
+
+  template <int dim>
+  void ProjectionScheme<dim>::prepare_for_checkpoint()
+  {
+    attach_time_levels(true);
+  }
+
+  template <int dim>
+  void ProjectionScheme<dim>::checkpoint_written()
+  {
+    velocity_transfer.reset();
+    pressure_transfer.reset();
+    transfer_velocity_in.clear();
+    transfer_pressure_in.clear();
+  }
+
+  template <int dim>
+  void ProjectionScheme<dim>::resume_from_checkpoint()
+  {
+    allocate_vectors();
+    std::vector<VectorType *> velocities = {&u, &u_old};
+    std::vector<VectorType *> pressures  = {&p, &psi, &psi_old, &div_u};
+    // deserialize in the order of prepare_for_checkpoint()
+    Transfer(space.dof_velocity).deserialize(velocities);
+    Transfer(space.dof_pressure).deserialize(pressures);
+    // The saved values satisfied the constraints already; distributing
+    // again could change the last bit and the resumed run would drift
+    // from the uninterrupted one.
+    u_older          = u_old;
+    velocity_ghosted = u;
+    pressure_ghosted = p;
+    space.make_velocity_constraints(scene, !scene.has_inhomogeneous_velocity(), step_constraints);
+  }
+
+  template <int dim>
+  void ProjectionScheme<dim>::save(std::ostream &out) const
+  {
+    out << "ProjectionScheme " << std::setprecision(17) << current_time << " " << last_dt << " "
+        << n_steps << " " << last_change_rate << "\n";
+  }
+
+  template <int dim>
+  void ProjectionScheme<dim>::load(std::istream &in)
+  {
+    std::string tag;
+    in >> tag >> current_time >> last_dt >> n_steps >> last_change_rate;
+    AssertThrow(tag == "ProjectionScheme" && !in.fail(),
+                ExcMessage("checkpoint: cannot read the fluid's time levels"));
   }
 
   template <int dim>

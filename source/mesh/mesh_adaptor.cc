@@ -9,6 +9,9 @@
 #include <suspension/mesh/mesh_adaptor.h>
 
 #include <cmath>
+#include <iomanip>
+#include <istream>
+#include <ostream>
 #include <optional>
 
 namespace Suspension
@@ -251,6 +254,22 @@ namespace Suspension
     l.cells_on_finest        = Utilities::MPI::sum(finest, comm);
     l.coarse_interface_cells = Utilities::MPI::sum(coarse_interface, comm);
     return l;
+  }
+
+  template <int dim>
+  void MeshAdaptor<dim>::save(std::ostream &out) const
+  {
+    out << "MeshAdaptor " << steps_since << " " << std::setprecision(17) << distance_since
+        << "\n";
+  }
+
+  template <int dim>
+  void MeshAdaptor<dim>::load(std::istream &in)
+  {
+    std::string tag;
+    in >> tag >> steps_since >> distance_since;
+    AssertThrow(tag == "MeshAdaptor" && !in.fail(),
+                ExcMessage("checkpoint: cannot read the mesh adaptor's counters"));
   }
 
   template class MeshAdaptor<2>;

@@ -5,6 +5,9 @@
 #include <suspension/postprocess/field_output.h>
 
 #include <fstream>
+#include <iomanip>
+#include <istream>
+#include <ostream>
 
 namespace Suspension::Postprocess
 {
@@ -120,6 +123,29 @@ namespace Suspension::Postprocess
         std::ofstream pvd(directory + "/solution.pvd");
         DataOutBase::write_pvd_record(pvd, records);
       }
+  }
+
+  template <int dim>
+  void FieldOutput<dim>::save(std::ostream &out) const
+  {
+    // file names have no white space (they are built from "solution")
+    out << "FieldOutput " << counter << " " << records.size() << std::setprecision(17);
+    for (const auto &[time, name] : records)
+      out << " " << time << " " << name;
+    out << "\n";
+  }
+
+  template <int dim>
+  void FieldOutput<dim>::load(std::istream &in)
+  {
+    std::string tag;
+    std::size_t n = 0;
+    in >> tag >> counter >> n;
+    records.resize(n);
+    for (auto &[time, name] : records)
+      in >> time >> name;
+    AssertThrow(tag == "FieldOutput" && !in.fail(),
+                ExcMessage("checkpoint: cannot read the field output's records"));
   }
 
   template class FieldOutput<2>;

@@ -11,6 +11,7 @@
 #include <suspension/solid/solid_phase.h>
 
 #include <cmath>
+#include <iomanip>
 #include <sstream>
 
 namespace Suspension::Solid
@@ -141,6 +142,45 @@ namespace Suspension::Solid
     solution.update_ghost_values();
     transfer = std::make_unique<parallel::distributed::SolutionTransfer<dim, VectorType>>(dof_handler);
     transfer->prepare_for_coarsening_and_refinement(solution);
+  }
+
+  template <int dim>
+  void SolidPhase<dim>::prepare_for_checkpoint()
+  {
+    solution.update_ghost_values();
+    transfer = std::make_unique<parallel::distributed::SolutionTransfer<dim, VectorType>>(dof_handler);
+    transfer->prepare_for_serialization(solution);
+  }
+
+  template <int dim>
+  void SolidPhase<dim>::checkpoint_written()
+  {
+    transfer.reset();
+  }
+
+  template <int dim>
+  void SolidPhase<dim>::resume_from_checkpoint(const Fluid::FluidSpace<dim> &fluid_space)
+  {
+    reinit_discretization(fluid_space);
+    parallel::distributed::SolutionTransfer<dim, VectorType>(dof_handler).deserialize(solution);
+    // as saved: already limited, so no limiter here (it would not be the
+    // uninterrupted run's state)
+    solution.zero_out_ghost_values();
+  }
+
+  template <int dim>
+  void SolidPhase<dim>::save(std::ostream &out) const
+  {
+    out << "SolidPhase " << std::setprecision(17) << initial_volume << " " << time << "\n";
+  }
+
+  template <int dim>
+  void SolidPhase<dim>::load(std::istream &in)
+  {
+    std::string tag;
+    in >> tag >> initial_volume >> time;
+    AssertThrow(tag == "SolidPhase" && !in.fail(),
+                ExcMessage("checkpoint: cannot read the solid's state"));
   }
 
   template <int dim>

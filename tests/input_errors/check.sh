@@ -34,6 +34,8 @@ expect bad_dimension      "$dir/bad_dimension.prm"     -- "bad_dimension.prm" "D
 expect missing_file       "$dir/no_such_file.prm"      -- "no_such_file.prm" "cannot read"
 expect too_dense          "$dir/too_dense.prm"         -- "too_dense.prm" "Solid/Seeding/Volume fraction" "could place only"
 expect statistics_box     "$dir/statistics_not_channel.prm" -- "statistics_not_channel.prm" "Statistics/Enabled" "channel"
+expect no_checkpoint       "$dir/../checkpoint_restart/scene.prm" --resume -- "no checkpoint" "output_files/checkpoint"
+expect bad_option         "$dir/../checkpoint_restart/scene.prm" --resum -- "unknown or incomplete option" "--resum"
 expect no_argument                                     -- "no parameter file"
 
 echo "$failures failure(s)"

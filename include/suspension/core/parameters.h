@@ -330,6 +330,19 @@ namespace Suspension::Parameters
   };
 
   /// All subsections together: what a Simulation is built from.
+  /// Checkpoints to <Output directory>/checkpoint/ for `suspension FILE.prm
+  /// --resume`.
+  struct Checkpoint
+  {
+    unsigned int interval_steps   = 0;
+    double       interval_minutes = 0.;
+    /// Set from the command line (--resume), not from the file.
+    bool resume = false;
+
+    static void declare(ParameterHandler &prm);
+    void        parse(ParameterHandler &prm);
+  };
+
   struct All
   {
     unsigned int       dimension = 2;
@@ -347,6 +360,7 @@ namespace Suspension::Parameters
     Output             output;
     Statistics         statistics;
     Verification       verification;
+    Checkpoint         checkpoint;
 
     static void declare(ParameterHandler &prm, unsigned int dim);
     void        parse(ParameterHandler &prm, unsigned int dim);

@@ -34,6 +34,10 @@ namespace Suspension
     /// refinement region of the 'Mesh' subsection.
     void create_mesh(parallel::distributed::Triangulation<dim> &tria) const;
 
+    /// Only the base mesh and its periodicity: what Triangulation::load()
+    /// of a checkpoint expects to find.
+    void create_coarse_mesh(parallel::distributed::Triangulation<dim> &tria) const;
+
     /// Directions d whose faces 2d and 2d+1 are identified.
     const std::vector<unsigned int> &periodic_directions() const;
 

@@ -5,6 +5,7 @@
 #include <deal.II/base/timer.h>
 #include <deal.II/distributed/tria.h>
 
+#include <suspension/core/checkpoint.h>
 #include <suspension/core/parameters.h>
 #include <suspension/core/scene.h>
 #include <suspension/fluid/fluid_operators.h>
@@ -52,6 +53,20 @@ namespace Suspension
 
   private:
     void   setup();
+    /// Instead of setup() with --resume: the mesh, fields and scalars of
+    /// the last checkpoint. Returns the time step to continue with.
+    double resume();
+    void   report_seeding() const;
+    void   write_checkpoint(double dt, double wall_time);
+    /// Every scalar the next step and the final report depend on, and the
+    /// parts' own (text; see Checkpoint).
+    std::string save_state(double dt, double wall_time) const;
+    /// Returns dt.
+    double load_state(const std::string &state, const std::string &path);
+    /// The first line of a checkpoint's state: what a resumed run must
+    /// match before p4est reads the mesh (dimension, coarse cells, finite
+    /// elements), and the rank count it was written on.
+    std::string checkpoint_header() const;
     void   create_initial_mesh();
     bool   adapt_mesh();
     void   change_mesh_with_fields();
@@ -108,5 +123,7 @@ namespace Suspension
     types::global_cell_index                  worst_coarse_interface = 0; // over all steps
     unsigned int                              n_adaptations          = 0;
     unsigned int                              n_outputs              = 0;
+    Checkpoint<dim>                           checkpoint;
+    double wall_time_before = 0.; // of the run up to the checkpoint it resumed from
   };
 } // namespace Suspension

@@ -9,8 +9,8 @@
 #include <deal.II/base/timer.h>
 #include <deal.II/distributed/solution_transfer.h>
 
+#include <iosfwd>
 #include <memory>
-
 #include <optional>
 #include <vector>
 
@@ -80,6 +80,21 @@ namespace Suspension::Fluid
     /// velocity is interpolated afresh instead.
     void finish_mesh_change(Function<dim> *prescribed_velocity = nullptr);
 
+    /// Checkpoint: hands the same time levels, and Pi div u (the initial
+    /// guess of the next mass solve), to the triangulation's next save() (SolutionTransfer::prepare_for_serialization); the copies
+    /// live until checkpoint_written().
+    void prepare_for_checkpoint();
+    void checkpoint_written();
+
+    /// After Triangulation::load() of a checkpoint and the space (and
+    /// operators) set up: the time levels back, as they were saved (no
+    /// constraints applied: they hold already). Call load() too.
+    void resume_from_checkpoint();
+
+    /// Time, step number and last step size (text, full precision).
+    void save(std::ostream &out) const;
+    void load(std::istream &in);
+
     /// Advances from the current time by dt.
     StepReport advance(double dt, const std::vector<const MomentumSource<dim> *> &sources);
 
@@ -107,6 +122,9 @@ namespace Suspension::Fluid
     void       assemble_momentum_rhs(double dt, double t_new,
                                      const std::vector<const MomentumSource<dim> *> &sources);
     void       allocate_vectors();
+    /// Ghosted copies of the transferred time levels, handed to new
+    /// SolutionTransfer objects.
+    void       attach_time_levels(bool serialization);
     void       update_unit_response();
     double     flux(const VectorType &u) const;
 

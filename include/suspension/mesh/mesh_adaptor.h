@@ -7,6 +7,7 @@
 #include <suspension/fluid/fluid_operators.h>
 #include <suspension/solid/solid_phase.h>
 
+#include <iosfwd>
 #include <memory>
 #include <vector>
 
@@ -76,6 +77,10 @@ namespace Suspension
     /// face pairs wrong there (dealii/dealii#8905), which corrupted B in a
     /// particle straddling the periodic boundary.
     bool flag_periodic_hanging_faces();
+
+    /// The counters due() keeps (text, full precision; checkpoints).
+    void save(std::ostream &out) const;
+    void load(std::istream &in);
 
   private:
     /// Makes the flags of cells facing each other across periodic faces

@@ -5,6 +5,7 @@
 #include <suspension/fluid/fluid_space.h>
 #include <suspension/fluid/fluid_operators.h>
 
+#include <iosfwd>
 #include <string>
 #include <utility>
 #include <vector>
@@ -39,6 +40,10 @@ namespace Suspension::Postprocess
                double                        density,
                double                        time,
                const std::vector<ExtraField<dim>> &extra_fields = {});
+
+    /// The counter and the .pvd records (checkpoints).
+    void save(std::ostream &out) const;
+    void load(std::istream &in);
 
   private:
     std::string                                  directory;

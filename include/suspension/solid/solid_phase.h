@@ -14,6 +14,7 @@
 #include <suspension/solid/transport_operator.h>
 
 #include <array>
+#include <iosfwd>
 #include <memory>
 
 namespace Suspension::Solid
@@ -89,6 +90,20 @@ namespace Suspension::Solid
     /// limited back into 0 <= phi <= 1 and B SPD.
     void finish_mesh_change(const Fluid::FluidSpace<dim> &fluid_space);
 
+    /// Checkpoint: hands phi and B to the triangulation's next save();
+    /// checkpoint_written() lets go of them.
+    void prepare_for_checkpoint();
+    void checkpoint_written();
+
+    /// After Triangulation::load() of a checkpoint (and after the fluid's
+    /// resume_from_checkpoint(), the order of saving): DoFs and operator,
+    /// fields as saved. Call load() too.
+    void resume_from_checkpoint(const Fluid::FluidSpace<dim> &fluid_space);
+
+    /// Initial volume and time (text, full precision).
+    void save(std::ostream &out) const;
+    void load(std::istream &in);
+
     /// Per active cell (index active_cell_index(), filled for locally
     /// owned cells): interface if epsilon < phi < 1 - epsilon at a node or
     /// quadrature point (or phi jumps across that range inside the cell),
@@ -126,6 +141,7 @@ namespace Suspension::Solid
              std::vector<SymmetricTensor<2, dim>> &stress) const override;
 
     const DoFHandler<dim> &get_dof_handler() const { return dof_handler; }
+    const FiniteElement<dim> &get_fe() const { return fe; }
     const VectorType      &get_solution() const { return solution; }
     std::vector<std::string> component_names() const;
 
