@@ -1184,8 +1184,13 @@ namespace Suspension::Parameters
 
   void All::resolve_contact_force()
   {
-    auto &c   = solid.contact;
-    c.enabled = solid.enabled() &&
+    auto      &c        = solid.contact;
+    const bool solved_u = fluid_solver.mode != VelocityMode::prescribed;
+    if (c.mode == "on" && !solved_u)
+      throw InputError("Solid/Contact force/Enabled",
+                       "a prescribed velocity ignores forces; use 'auto' or 'off'");
+    // a prescribed velocity needs no force: 'auto' leaves it off
+    c.enabled = solid.enabled() && solved_u &&
                 (c.mode == "on" || (c.mode == "auto" && solid.particles.size() >= 2));
     if (!c.enabled)
       return;
