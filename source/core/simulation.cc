@@ -75,7 +75,8 @@ namespace Suspension
       solid = std::make_unique<Solid::SolidPhase<dim>>(parameters, triangulation);
     if (parameters.solid.contact.enabled)
       contact = std::make_unique<Solid::ContactForce<dim>>(parameters, scene.no_slip_walls(),
-                                                           scene.periods());
+                                                           scene.periods(), scene.lower_corner(),
+                                                           scene.upper_corner());
     if (parameters.statistics.enabled)
       channel_statistics =
         std::make_unique<Postprocess::ChannelStatistics<dim>>(parameters, communicator);

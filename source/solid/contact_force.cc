@@ -147,24 +147,16 @@ namespace Suspension::Solid
   template <int dim>
   ContactForce<dim>::ContactForce(const Parameters::All                              &parameters,
                                   const std::vector<std::pair<unsigned int, double>> &walls,
-                                  const std::array<double, dim>                       &periods)
+                                  const std::array<double, dim>                       &periods,
+                                  const Point<dim>                                    &lower_corner,
+                                  const Point<dim>                                    &upper_corner)
     : settings(parameters.solid.contact)
     , scale(parameters.material.viscosity * parameters.solid.contact.velocity_scale *
             parameters.solid.contact.radius)
     , walls(walls)
     , periods(periods)
-    , lower_corner([&] {
-      Point<dim> p;
-      for (unsigned int d = 0; d < dim; ++d)
-        p[d] = parameters.geometry.box_lower[d];
-      return p;
-    }())
-    , upper_corner([&] {
-      Point<dim> p;
-      for (unsigned int d = 0; d < dim; ++d)
-        p[d] = parameters.geometry.box_upper[d];
-      return p;
-    }())
+    , lower_corner(lower_corner)
+    , upper_corner(upper_corner)
   {}
 
   template <int dim>

@@ -61,10 +61,13 @@ namespace Suspension::Solid
   {
   public:
     /// walls: (direction, coordinate) of each no-slip plane;
-    /// periods: length of each periodic direction, 0 if not periodic.
+    /// periods: length of each periodic direction, 0 if not periodic;
+    /// the corners of the domain (Scene::lower_corner(), upper_corner()).
     ContactForce(const Parameters::All                       &parameters,
                  const std::vector<std::pair<unsigned int, double>> &walls,
-                 const std::array<double, dim>                &periods);
+                 const std::array<double, dim>                &periods,
+                 const Point<dim>                             &lower_corner,
+                 const Point<dim>                             &upper_corner);
 
     /// Labels the particles of the current phi, finds their surfaces and
     /// the force in every locally owned fluid cell. Call after phi moved
