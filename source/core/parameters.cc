@@ -295,8 +295,13 @@ namespace Suspension::Parameters
                       Patterns::Integer(0, 16), "Level inside 'Region'.");
     prm.declare_entry("Interval", std::to_string(d.interval), Patterns::Integer(0),
                       "Adapt every this many steps; 0: from the CFL number, "
-                      "so that the interface cannot cross half the buffer "
-                      "between two adaptations (doc/method.md).");
+                      "so that the interface cannot cross 'Buffer fraction' "
+                      "of the buffer between two adaptations (doc/method.md).");
+    prm.declare_entry("Buffer fraction", "0.5", Patterns::Double(0.05, 1.),
+                      "With Interval = 0: adapt once the fastest material "
+                      "point may have moved this fraction of 'Buffer cells' "
+                      "finest cells. Larger: fewer adaptations, a thinner "
+                      "margin before the interface leaves the finest band.");
     prm.declare_entry("Initial cycles", std::to_string(d.initial_cycles),
                       Patterns::Integer(0, 20),
                       "Adapt-and-reinitialise cycles on the initial condition; "
@@ -318,6 +323,7 @@ namespace Suspension::Parameters
     region              = Utilities::trim(prm.get("Region"));
     region_level        = prm.get_integer("Region level");
     interval            = prm.get_integer("Interval");
+    buffer_fraction     = prm.get_double("Buffer fraction");
     initial_cycles      = prm.get_integer("Initial cycles");
     prm.leave_subsection();
     if (!enabled)
@@ -564,6 +570,14 @@ namespace Suspension::Parameters
                       Patterns::Double(1e-16, 1e-2),
                       "Relative residual reduction asked of every linear "
                       "solve (CG with BoomerAMG).");
+    prm.declare_entry("Momentum preconditioner",
+                      "amg",
+                      Patterns::Selection("amg|jacobi"),
+                      "Preconditioner of the momentum predictor's CG: amg "
+                      "(BoomerAMG, few iterations, a set-up whenever the mesh "
+                      "or the time step changes) or jacobi (no set-up; enough "
+                      "when the mass term (alpha/dt) M dominates nu K, i.e. "
+                      "nu dt / h^2 is small, as in adaptive suspension runs).");
     prm.leave_subsection();
   }
 
@@ -582,6 +596,7 @@ namespace Suspension::Parameters
                          ConvectionForm::none :
                          ConvectionForm::skew_symmetric;
     solver_tolerance = prm.get_double("Linear solver tolerance");
+    jacobi_momentum  = prm.get("Momentum preconditioner") == "jacobi";
     prm.leave_subsection();
     if (mode == VelocityMode::prescribed)
       check_expression("Fluid solver/Prescribed velocity", prescribed_velocity, dim, dim);
@@ -650,7 +665,18 @@ namespace Suspension::Parameters
                       std::to_string(d.elastic_number),
                       Patterns::Double(1e-3, 100.),
                       "Time-step limit dt sqrt(G / rho) / h of the explicit "
-                      "elastic coupling (elastic wave crossing a cell).");
+                      "elastic coupling (elastic wave crossing a cell); not "
+                      "applied with 'Elastic coupling = semi-implicit'.");
+    prm.declare_entry("Elastic coupling", "explicit",
+                      Patterns::Selection("explicit|semi-implicit"),
+                      "explicit: the stress G phi (B - I) of the transported B "
+                      "is a load of the momentum predictor, the step is "
+                      "limited by 'Elastic number'. semi-implicit: the "
+                      "increment dt G phi (grad du B + B grad du^T) / 2 of the "
+                      "velocity correction du = u^{n+1} - u* is carried into the "
+                      "predictor (Crank-Nicolson weight), which lifts the "
+                      "elastic-wave limit at the price of a momentum matrix "
+                      "and preconditioner per step (doc/method.md).");
     prm.declare_entry("Body force", zero_vector(dim), Patterns::Anything(),
                       "Force per unit volume of solid g(x, y[, z], t), one "
                       "expression per component separated by ';', applied as "
@@ -719,6 +745,7 @@ namespace Suspension::Parameters
     limiter             = prm.get_bool("Limiter");
     transport_cfl       = prm.get_double("Transport CFL");
     elastic_number      = prm.get_double("Elastic number");
+    semi_implicit       = prm.get("Elastic coupling") == "semi-implicit";
     body_force          = {prm.get("Body force"), constants};
     const std::string list = prm.get("Particles");
     prm.enter_subsection("Seeding");

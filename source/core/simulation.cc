@@ -69,6 +69,8 @@ namespace Suspension
     , checkpoint(parameters, communicator)
   {
     fluid.set_timer(timer);
+    operators.jacobi_momentum = parameters.fluid_solver.jacobi_momentum;
+    operators.step_matrix     = parameters.solid.semi_implicit && parameters.solid.elastic();
     if (parameters.fluid_solver.mode == Parameters::VelocityMode::prescribed)
       prescribed_velocity = make_function<dim>(parameters.fluid_solver.prescribed_velocity, dim);
     if (parameters.solid.enabled())
@@ -389,7 +391,8 @@ namespace Suspension
     // sqrt(G lambda_max(B) / rho).
     // Like the CFL step, it is cut with a margin (0.9) rather than followed
     // step by step: each new dt costs a new momentum matrix.
-    if (solid && parameters.solid.elastic() && !prescribed_velocity)
+    if (solid && parameters.solid.elastic() && !prescribed_velocity &&
+        !parameters.solid.semi_implicit)
       {
         const double elastic = parameters.solid.elastic_number * smallest_cell_size /
                                std::sqrt(parameters.solid.shear_modulus *

@@ -11,13 +11,15 @@ namespace Suspension::Fluid
 {
   namespace
   {
+    /// One sparsity pattern for all the given matrices (building it is
+    /// the expensive part of a mesh change).
     template <int dim>
-    void make_matrix(MatrixType                      &matrix,
-                     const DoFHandler<dim>           &dof,
-                     const IndexSet                  &owned,
-                     const IndexSet                  &relevant,
-                     const AffineConstraints<double> &constraints,
-                     const bool                       components_decoupled)
+    void make_matrices(const std::vector<MatrixType *>  &matrices,
+                       const DoFHandler<dim>           &dof,
+                       const IndexSet                  &owned,
+                       const IndexSet                  &relevant,
+                       const AffineConstraints<double> &constraints,
+                       const bool                       components_decoupled)
     {
       DynamicSparsityPattern dsp(relevant);
       const unsigned int     nc = dof.get_fe().n_components();
@@ -28,7 +30,8 @@ namespace Suspension::Fluid
                              DoFTools::always : DoFTools::none;
       DoFTools::make_sparsity_pattern(dof, coupling, dsp, constraints, false);
       SparsityTools::distribute_sparsity_pattern(dsp, owned, dof.get_communicator(), relevant);
-      matrix.reinit(owned, owned, dsp, dof.get_communicator());
+      for (auto *matrix : matrices)
+        matrix->reinit(owned, owned, dsp, dof.get_communicator());
     }
   } // namespace
 
@@ -36,16 +39,15 @@ namespace Suspension::Fluid
   void FluidOperators<dim>::reinit(const FluidSpace<dim> &space)
   {
     communicator = space.communicator();
-    make_matrix(M, space.dof_velocity, space.owned_velocity, space.relevant_velocity,
-                space.velocity_constraints, true);
-    make_matrix(K, space.dof_velocity, space.owned_velocity, space.relevant_velocity,
-                space.velocity_constraints, true);
-    make_matrix(A, space.dof_velocity, space.owned_velocity, space.relevant_velocity,
-                space.velocity_constraints, true);
-    make_matrix(L, space.dof_pressure, space.owned_pressure, space.relevant_pressure,
-                space.increment_constraints, false);
-    make_matrix(Mp, space.dof_pressure, space.owned_pressure, space.relevant_pressure,
-                space.pressure_constraints, false);
+    make_matrices({&M, &K, &A}, space.dof_velocity, space.owned_velocity,
+                  space.relevant_velocity, space.velocity_constraints, true);
+    if (step_matrix)
+      make_matrices({&A_step}, space.dof_velocity, space.owned_velocity,
+                    space.relevant_velocity, space.velocity_constraints, false);
+    make_matrices({&L}, space.dof_pressure, space.owned_pressure, space.relevant_pressure,
+                  space.increment_constraints, false);
+    make_matrices({&Mp}, space.dof_pressure, space.owned_pressure, space.relevant_pressure,
+                  space.pressure_constraints, false);
 
     // D: pressure rows condensed, velocity columns kept as they are.
     const AffineConstraints<double> no_constraints;
@@ -158,6 +160,11 @@ namespace Suspension::Fluid
     momentum_alpha_over_dt = alpha_over_dt;
     momentum_nu            = nu;
 
+    if (jacobi_momentum)
+      {
+        jacobi_momentum_preconditioner = std::make_unique<PETScWrappers::PreconditionJacobi>(A);
+        return;
+      }
     amg_momentum = std::make_unique<PETScWrappers::PreconditionBoomerAMG>();
     PETScWrappers::PreconditionBoomerAMG::AdditionalData data;
     data.symmetric_operator = true;
@@ -199,7 +206,39 @@ namespace Suspension::Fluid
   unsigned int FluidOperators<dim>::solve_momentum(VectorType &x, const VectorType &b,
                                                    const double tolerance) const
   {
+    if (jacobi_momentum)
+      return cg_solve(A, x, b, *jacobi_momentum_preconditioner, tolerance, communicator);
     return cg_solve(A, x, b, *amg_momentum, tolerance, communicator);
+  }
+
+  template <int dim>
+  void FluidOperators<dim>::prepare_step_matrix()
+  {
+    amg_step = std::make_unique<PETScWrappers::PreconditionBoomerAMG>();
+    PETScWrappers::PreconditionBoomerAMG::AdditionalData data;
+    data.symmetric_operator = false;
+    data.strong_threshold   = dim == 2 ? 0.25 : 0.5;
+    data.relaxation_type_coarse =
+      PETScWrappers::PreconditionBoomerAMG::AdditionalData::RelaxationType::symmetricSORJacobi;
+    data.n_sweeps_coarse = 2;
+    amg_step->initialize(A_step, data);
+  }
+
+  template <int dim>
+  unsigned int FluidOperators<dim>::solve_step_matrix(VectorType &x, const VectorType &b,
+                                                      const double tolerance) const
+  {
+    const double norm = b.l2_norm();
+    if (norm == 0.)
+      {
+        x = 0.;
+        return 0;
+      }
+    SolverControl                control(5000, tolerance * norm);
+    PETScWrappers::SolverGMRES   gmres(control, communicator,
+                                     PETScWrappers::SolverGMRES::AdditionalData(50));
+    gmres.solve(A_step, x, b, *amg_step);
+    return control.last_step();
   }
 
   template <int dim>

@@ -257,10 +257,12 @@ namespace Suspension::Fluid
     Sections section(timer, "fluid: matrices for new dt");
     const double old_alpha_over_dt = operators.momentum_alpha_over_dt;
     operators.set_momentum_coefficients(alpha / dt, nu);
+    const bool driven = parameters.flow_driving.type != Parameters::FlowDrivingType::none;
     if (operators.momentum_alpha_over_dt != old_alpha_over_dt)
       {
         report.matrices_rebuilt = true;
-        if (parameters.flow_driving.type != Parameters::FlowDrivingType::none)
+        // (with a step matrix the response is recomputed every step)
+        if (driven && !operators.step_matrix)
           update_unit_response();
       }
 
@@ -296,9 +298,26 @@ namespace Suspension::Fluid
       space.make_velocity_constraints(scene, !scene.has_inhomogeneous_velocity(),
                                       step_constraints);
     assemble_momentum_rhs(dt, t_new, sources);
-    section.next("fluid: momentum solve");
-    report.momentum_iterations =
-      operators.solve_momentum(u, rhs_u, parameters.fluid_solver.solver_tolerance);
+    const double tolerance = parameters.fluid_solver.solver_tolerance;
+    if (operators.step_matrix)
+      {
+        section.next("fluid: semi-implicit preconditioner");
+        operators.prepare_step_matrix();
+        section.next("fluid: momentum solve");
+        report.momentum_iterations = operators.solve_step_matrix(u, rhs_u, tolerance);
+        if (driven)
+          {
+            VectorType b(operators.unit_force);
+            b /= parameters.material.density;
+            report.momentum_iterations += operators.solve_step_matrix(unit_response, b, tolerance);
+            space.velocity_constraints.distribute(unit_response);
+          }
+      }
+    else
+      {
+        section.next("fluid: momentum solve");
+        report.momentum_iterations = operators.solve_momentum(u, rhs_u, tolerance);
+      }
     step_constraints.distribute(u);
 
     // 2. flow-rate control by linearity
@@ -381,8 +400,17 @@ namespace Suspension::Fluid
     const double dt, const double t_new,
     const std::vector<const MomentumSource<dim> *> &sources)
   {
-    (void)dt;
     rhs_u = 0.;
+    // Semi-implicit elastic coupling: the stress increment of the velocity
+    // correction du = u^{n+1} - u*, theta dt G phi (grad du B + B grad du^T),
+    // joins the predictor; theta = 1/2 (Crank-Nicolson). For the elastic
+    // wave rho u_t = div tau, tau_t = G grad u this scheme is stable for
+    // any dt once theta >= 1/4 (doc/method.md), where the explicit one
+    // needs c dt / h below about 1.
+    const bool   semi_implicit = operators.step_matrix;
+    const double theta         = 0.5;
+    if (semi_implicit)
+      operators.A_step = 0.;
     const bool convection =
       parameters.fluid_solver.convection != Parameters::ConvectionForm::none;
     bool any_stress = false;
@@ -404,6 +432,9 @@ namespace Suspension::Fluid
     std::vector<Tensor<2, dim>>          grad_u_star(n_q);
     std::vector<SymmetricTensor<2, dim>> stress(n_q);
     std::vector<unsigned int>            component(nu_dofs);
+    std::vector<double>                  modulus(n_q);
+    std::vector<SymmetricTensor<2, dim>> B(n_q);
+    Vector<double>                       u_star_local(nu_dofs), lifted(nu_dofs);
     for (unsigned int i = 0; i < nu_dofs; ++i)
       component[i] = space.fe_velocity.system_to_component_index(i).first;
     const double inv_rho = 1. / parameters.material.density;
@@ -452,6 +483,55 @@ namespace Suspension::Fluid
             }
 
           cell->get_dof_indices(dofs);
+          if (semi_implicit)
+            {
+              // the whole step matrix of the cell: (alpha/dt) M + nu K +
+              // theta dt / rho E(phi, B); E u* moves to the right-hand side
+              bool elastic = false;
+              for (const auto *s : sources)
+                elastic = s->elastic_stiffness(cell, space.quadrature.get_points(), modulus, B) ||
+                          elastic;
+              cell_matrix = 0;
+              for (unsigned int q = 0; q < n_q; ++q)
+                for (unsigned int i = 0; i < nu_dofs; ++i)
+                  for (unsigned int j = 0; j < nu_dofs; ++j)
+                    if (component[i] == component[j])
+                      cell_matrix(i, j) +=
+                        (operators.momentum_alpha_over_dt * fe_u.shape_value(i, q) *
+                           fe_u.shape_value(j, q) +
+                         nu * fe_u.shape_grad(i, q) * fe_u.shape_grad(j, q)) *
+                        fe_u.JxW(q);
+              if (elastic)
+                {
+                  // E_ij = int G phi [delta_{ci cj} g_i.B g_j + (B g_j)_{ci} (g_i)_{cj}]
+                  FullMatrix<double> cell_E(nu_dofs, nu_dofs);
+                  for (unsigned int q = 0; q < n_q; ++q)
+                    {
+                      const double w = theta * dt * inv_rho * modulus[q] * fe_u.JxW(q);
+                      if (w == 0.)
+                        continue;
+                      for (unsigned int j = 0; j < nu_dofs; ++j)
+                        {
+                          const Tensor<1, dim> Bg_j = B[q] * fe_u.shape_grad(j, q);
+                          const unsigned int   cj   = component[j];
+                          for (unsigned int i = 0; i < nu_dofs; ++i)
+                            {
+                              const Tensor<1, dim> &g_i = fe_u.shape_grad(i, q);
+                              const unsigned int    ci  = component[i];
+                              cell_E(i, j) +=
+                                w * ((ci == cj ? g_i * Bg_j : 0.) + Bg_j[ci] * g_i[cj]);
+                            }
+                        }
+                    }
+                  cell->get_dof_values(u_star_ghosted, u_star_local);
+                  cell_E.vmult(lifted, u_star_local);
+                  cell_rhs += lifted;
+                  cell_matrix.add(1., cell_E);
+                }
+              step_constraints.distribute_local_to_global(cell_matrix, cell_rhs, dofs,
+                                                          operators.A_step, rhs_u);
+              continue;
+            }
           bool inhomogeneous = false;
           for (const auto i : dofs)
             inhomogeneous = inhomogeneous || step_constraints.is_inhomogeneously_constrained(i);
@@ -475,6 +555,8 @@ namespace Suspension::Fluid
             step_constraints.distribute_local_to_global(cell_rhs, dofs, rhs_u);
         }
     rhs_u.compress(VectorOperation::add);
+    if (semi_implicit)
+      operators.A_step.compress(VectorOperation::add);
   }
 
   template <int dim>

@@ -51,7 +51,7 @@ namespace Suspension
     const bool now =
       settings.interval > 0 ?
         steps_since >= settings.interval :
-        distance_since >= 0.5 * settings.buffer_cells * finest_cell_size();
+        distance_since >= settings.buffer_fraction * settings.buffer_cells * finest_cell_size();
     if (now)
       {
         steps_since    = 0;
@@ -176,8 +176,27 @@ namespace Suspension
   {
     // Two cells facing each other across a periodic boundary move together:
     // refine if the other side is finer or will refine, coarsen only if it
-    // coarsens too. Cells whose periodic neighbour is a ghost's or
-    // artificial are left to flag_periodic_hanging_faces().
+    // coarsens too. The other side is often another rank's (the periodic
+    // faces of a Z-order partition lie on different ranks), so the flags
+    // are first copied to the ghost layer, which holds periodic neighbours.
+    // Whatever remains is left to flag_periodic_hanging_faces().
+    using Cell = typename Triangulation<dim>::active_cell_iterator;
+    enum : unsigned char { keep = 0, refine = 1, coarsen = 2 };
+    std::vector<unsigned char> flags(triangulation.n_active_cells(), keep);
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+        flags[cell->active_cell_index()] = cell->refine_flag_set()  ? refine :
+                                           cell->coarsen_flag_set() ? coarsen :
+                                                                      keep;
+    GridTools::exchange_cell_data_to_ghosts<unsigned char, Triangulation<dim>>(
+      triangulation,
+      [&](const Cell &cell) -> std::optional<unsigned char> {
+        return flags[cell->active_cell_index()];
+      },
+      [&](const Cell &cell, const unsigned char &value) {
+        flags[cell->active_cell_index()] = value;
+      });
+
     for (const auto &cell : triangulation.active_cell_iterators())
       if (cell->is_locally_owned())
         for (const unsigned int f : cell->face_indices())
@@ -189,14 +208,15 @@ namespace Suspension
                   cell->clear_coarsen_flag();
                   cell->set_refine_flag();
                 }
-              else if (other->is_locally_owned() && other->level() == cell->level())
+              else if (!other->is_artificial() && other->level() == cell->level())
                 {
-                  if (other->refine_flag_set())
+                  const unsigned char flag = flags[other->active_cell_index()];
+                  if (flag == refine)
                     {
                       cell->clear_coarsen_flag();
                       cell->set_refine_flag();
                     }
-                  else if (!other->coarsen_flag_set())
+                  else if (flag != coarsen)
                     cell->clear_coarsen_flag();
                 }
             }

@@ -88,6 +88,10 @@ namespace Suspension::Postprocess
   {
     const auto &tria = space.triangulation;
     DataOut<dim> data_out;
+    // zlib at its default level took more time than a time step
+    DataOutBase::VtkFlags vtk_flags;
+    vtk_flags.compression_level = DataOutBase::VtkFlags::best_speed;
+    data_out.set_flags(vtk_flags);
     data_out.attach_triangulation(tria);
 
     data_out.add_data_vector(space.dof_velocity,

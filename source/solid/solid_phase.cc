@@ -264,7 +264,18 @@ namespace Suspension::Solid
   {
     copy_velocity(u_begin, u0);
     copy_velocity(u_end, u1);
-    const unsigned int n_sub = std::max(1., std::ceil(dt / max_substep(speed_over_h) - 1e-12));
+    const double sub_steps = std::max(1., std::ceil(dt / max_substep(speed_over_h) - 1e-12));
+    // A flow that blew up without (yet) a NaN would make the transport
+    // crawl through millions of sub-steps: stop with the reason instead.
+    if (!(sub_steps <= 1000.))
+      {
+        std::ostringstream message;
+        message << "the velocity is too large for the transport (" << sub_steps << " sub-steps of the DG transport for one time step, "
+                << "max |u| k / h = " << speed_over_h
+                << "): the flow is unstable; reduce the time step or the CFL number";
+        throw std::runtime_error(message.str());
+      }
+    const unsigned int n_sub = static_cast<unsigned int>(sub_steps);
     const double       h     = dt / n_sub;
     const bool         scale = parameters.solid.limiter;
 
@@ -417,6 +428,17 @@ namespace Suspension::Solid
   template <int dim>
   void SolidPhase<dim>::check_B(const SolidDiagnostics &d, const double t) const
   {
+    // Without the limiter DG overshoots by a few per cent at a sharp edge;
+    // half a unit means the transport itself has become unstable.
+    if (!(d.min_phi > -0.5 && d.max_phi < 1.5))
+      {
+        std::ostringstream message;
+        message << "the solid fraction phi left [-0.5, 1.5] at t = " << t << " (range ["
+                << d.min_phi << ", " << d.max_phi
+                << "]): the transport is unstable; switch 'Solid/Limiter' on or reduce "
+                   "'Solid/Transport CFL'; the last state was written";
+        throw std::runtime_error(message.str());
+      }
     if (fe.n_components() == 1)
       return;
     if (!(d.min_eigenvalue_B > 0.) || !std::isfinite(d.volume))
@@ -539,7 +561,8 @@ namespace Suspension::Solid
     if (!stress_values || stress_values->n_quadrature_points != unit_points.size())
       stress_values = std::make_unique<FEValues<dim>>(fe, Quadrature<dim>(unit_points), update_values);
     stress_values->reinit(Fluid::FluidSpace<dim>::cell_of(cell, dof_handler));
-    std::vector<Vector<double>> values(unit_points.size(), Vector<double>(fe.n_components()));
+    point_values.resize(unit_points.size(), Vector<double>(fe.n_components()));
+    auto &values = point_values;
     stress_values->get_function_values(solution, values);
     if (body_force)
       {
@@ -557,6 +580,31 @@ namespace Suspension::Solid
           const auto ij = SymmetricTensor<2, dim>::unrolled_to_component_indices(c);
           stress[q][ij] += G * values[q][0] * (values[q][1 + c] - (ij[0] == ij[1] ? 1. : 0.));
         }
+  }
+
+  template <int dim>
+  bool SolidPhase<dim>::elastic_stiffness(
+    const typename Triangulation<dim>::active_cell_iterator &cell,
+    const std::vector<Point<dim>>                           &unit_points,
+    std::vector<double>                                     &modulus,
+    std::vector<SymmetricTensor<2, dim>>                    &B) const
+  {
+    if (!parameters.solid.semi_implicit || fe.n_components() == 1)
+      return false;
+    if (!stress_values || stress_values->n_quadrature_points != unit_points.size())
+      stress_values = std::make_unique<FEValues<dim>>(fe, Quadrature<dim>(unit_points), update_values);
+    stress_values->reinit(Fluid::FluidSpace<dim>::cell_of(cell, dof_handler));
+    point_values.resize(unit_points.size(), Vector<double>(fe.n_components()));
+    auto &values = point_values;
+    stress_values->get_function_values(solution, values);
+    const double G = parameters.solid.shear_modulus;
+    for (unsigned int q = 0; q < unit_points.size(); ++q)
+      {
+        modulus[q] = G * values[q][0];
+        for (unsigned int c = 0; c < n_B; ++c)
+          B[q][SymmetricTensor<2, dim>::unrolled_to_component_indices(c)] = values[q][1 + c];
+      }
+    return true;
   }
 
   template class SolidPhase<2>;

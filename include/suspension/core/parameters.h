@@ -94,6 +94,7 @@ namespace Suspension::Parameters
     std::string  region;                     // expression > 0 at the centre
     unsigned int region_level        = 0;
     unsigned int interval            = 0;    // steps; 0: from the CFL number
+    double       buffer_fraction     = 0.5;  // of the buffer crossed, Interval 0
     unsigned int initial_cycles      = 0;    // 0: maximum - global + 2
 
     static void declare(ParameterHandler &prm);
@@ -182,6 +183,7 @@ namespace Suspension::Parameters
     ProjectionForm projection      = ProjectionForm::rotational;
     ConvectionForm convection      = ConvectionForm::skew_symmetric;
     double         solver_tolerance = 1e-10;
+    bool           jacobi_momentum  = false; // else BoomerAMG
 
     static void declare(ParameterHandler &prm, unsigned int dim);
     void        parse(ParameterHandler &prm, unsigned int dim);
@@ -208,6 +210,9 @@ namespace Suspension::Parameters
     bool                             limiter       = true;
     double                           transport_cfl = 0.5;
     double                           elastic_number = 0.5;
+    /// semi-implicit: the stress increment dt G phi (grad u B + B grad u^T),
+    /// linear in the new velocity, goes into the momentum predictor
+    bool                             semi_implicit = false;
     /// force per unit volume of solid, applied as phi g (x, t)
     FunctionExpression               body_force{"", ""};
 

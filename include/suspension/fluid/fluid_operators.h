@@ -40,19 +40,32 @@ namespace Suspension::Fluid
     /// unchanged arguments (nothing is done).
     void set_momentum_coefficients(double alpha_over_dt, double nu);
 
+    /// Semi-implicit elastic coupling: the step matrix A + theta dt/rho E
+    /// couples the velocity components and changes every step; assembled
+    /// by the projection scheme into `A_step`, then this sets up its
+    /// preconditioner.
+    void         prepare_step_matrix();
+    /// GMRES + BoomerAMG on A_step (E is not symmetric for B != I).
+    unsigned int solve_step_matrix(VectorType &x, const VectorType &b, double tolerance) const;
+
     /// Solves with CG + the stored preconditioner; returns iterations.
     unsigned int solve_momentum(VectorType &x, const VectorType &b, double tolerance) const;
     unsigned int solve_pressure_laplace(VectorType &x, const VectorType &b, double tolerance) const;
     unsigned int solve_pressure_mass(VectorType &x, const VectorType &b, double tolerance) const;
 
     MatrixType M, K, A, L, Mp, D;
+    MatrixType A_step; // only with 'step_matrix'
+    /// Allocate A_step (semi-implicit elastic coupling).
+    bool step_matrix = false;
     VectorType flux_weights; // m_x
     VectorType unit_force;   // b_x
     double     momentum_alpha_over_dt = -1., momentum_nu = -1.;
+    /// Jacobi instead of BoomerAMG for A (no set-up cost).
+    bool jacobi_momentum = false;
 
   private:
     MPI_Comm                                             communicator;
-    std::unique_ptr<PETScWrappers::PreconditionBoomerAMG> amg_momentum, amg_pressure;
-    std::unique_ptr<PETScWrappers::PreconditionJacobi>    jacobi_mass;
+    std::unique_ptr<PETScWrappers::PreconditionBoomerAMG> amg_momentum, amg_pressure, amg_step;
+    std::unique_ptr<PETScWrappers::PreconditionJacobi>    jacobi_mass, jacobi_momentum_preconditioner;
   };
 } // namespace Suspension::Fluid

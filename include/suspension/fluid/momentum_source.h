@@ -43,5 +43,21 @@ namespace Suspension::Fluid
     {
       return true;
     }
+
+    /// For a semi-implicit coupling: the stress increment of the source
+    /// under a velocity gradient L held for a time dt is
+    /// dt modulus[q] (L B[q] + B[q] L^T) at the points of `cell`. Returns
+    /// false (and fills nothing) for sources without elastic stiffness.
+    virtual bool elastic_stiffness(const typename Triangulation<dim>::active_cell_iterator &cell,
+                                   const std::vector<Point<dim>> &unit_points,
+                                   std::vector<double>                  &modulus,
+                                   std::vector<SymmetricTensor<2, dim>> &B) const
+    {
+      (void)cell;
+      (void)unit_points;
+      (void)modulus;
+      (void)B;
+      return false;
+    }
   };
 } // namespace Suspension::Fluid

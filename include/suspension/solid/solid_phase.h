@@ -139,6 +139,11 @@ namespace Suspension::Solid
              double                          time,
              std::vector<Tensor<1, dim>>          &force,
              std::vector<SymmetricTensor<2, dim>> &stress) const override;
+    /// G phi and B at the points, if 'Elastic coupling = semi-implicit'.
+    bool elastic_stiffness(const typename Triangulation<dim>::active_cell_iterator &cell,
+                           const std::vector<Point<dim>> &unit_points,
+                           std::vector<double>                  &modulus,
+                           std::vector<SymmetricTensor<2, dim>> &B) const override;
 
     const DoFHandler<dim> &get_dof_handler() const { return dof_handler; }
     const FiniteElement<dim> &get_fe() const { return fe; }
@@ -163,6 +168,7 @@ namespace Suspension::Solid
     VectorType             solution, stage, stage_rhs, u0, u1, u_stage;
     double                 initial_volume = 0., time = 0.;
     mutable std::unique_ptr<FEValues<dim>> stress_values;
+    mutable std::vector<Vector<double>>    point_values; // reused: add() runs on every cell
     std::unique_ptr<Function<dim>>         body_force; // null: none
     std::unique_ptr<parallel::distributed::SolutionTransfer<dim, VectorType>> transfer;
   };
