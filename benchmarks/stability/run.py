@@ -46,7 +46,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
 QUICK = "--quick" in sys.argv
-WORK = os.path.join(HERE, "work_quick" if QUICK else "work")
+WORK = os.environ.get("BENCHMARK_WORK", os.path.join(HERE, "work_quick" if QUICK else "work"))
 OUT = WORK if QUICK else HERE
 sys.path.insert(0, os.path.join(REPO, "scripts"))
 from statistics_table import read_table as read_statistics  # noqa: E402
