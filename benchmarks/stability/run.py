@@ -10,7 +10,7 @@ Usage (from the repository root, after a build in build/):
 Sweeps the time step (shown as CFL number |u|max dt / h and as elastic
 number dt sqrt(G / rho) / h), the capillary number Ca = mu shear / G and the
 particle Reynolds number Re = rho shear r^2 / mu for the disc in shear
-(disc_shear.prm, level 5: 12.8 cells per diameter, to t = 0.5), for each
+(disc_shear.prm, level 4: 6.4 cells per diameter, to t = 0.5), for each
 scheme: elastic coupling explicit / semi-implicit, DG degree 1 / 2, phi
 limiter on / off. Plus the elastic disc in the lid-driven cavity
 (disc_cavity.prm) across the time step for both couplings.
@@ -65,7 +65,7 @@ if QUICK:
     SCHEMES = [("explicit", 1, True, (0.01,), (0.1,)), ("semi-implicit", 1, True, (0.01,), (0.1,))]
     CAVITY = []
 else:
-    LEVEL, END = 5, 0.5
+    LEVEL, END = 4, 0.5
     STEPS = (0.05, 0.1, 0.2, 0.4, 0.8, 1.6)
     FULL, CORNERS = ((0.01, 0.1, 1.0), (0.1, 1.0, 10.0)), ((0.01, 1.0), (0.1, 10.0))
     # the full Ca x Re grid for the default DG degree 1 with the limiter,
@@ -265,8 +265,13 @@ def plot(rows, out_dir):
         ax.axvline(1.0, color="k", ls="--", lw=1)
         ax.text(1.05, lo_y * 1.2, "CFL = 1\n(explicit convection)", fontsize=7)
         if scheme.startswith("explicit"):
+            # c dt k_max <= 2 (the explicit wave step), k_max^2 = 60 / h^2 the
+            # largest eigenvalue of M^-1 K for 1D P2 elements
             ax.axhline(1.0, color="k", ls=":", lw=1)
             ax.text(lo_x * 1.1, 1.1, "elastic wave crosses a cell (En = 1)", fontsize=7)
+            ax.axhline(2 / math.sqrt(60), color="k", ls="-.", lw=1)
+            ax.text(lo_x * 1.1, 2 / math.sqrt(60) * 0.8, "c dt k_max = 2 for Q2 (En = 0.26)",
+                    fontsize=7)
         ax.set_xlim(lo_x, hi_x)
         ax.set_ylim(lo_y, hi_y)
         ax.set_xlabel("CFL number |u|max dt / h")
