@@ -4,7 +4,8 @@
 Usage (from the repository root, after a build in build/):
 
     python3 benchmarks/failure_pushes/run.py            # all pushes (wall time in README.md)
-    python3 benchmarks/failure_pushes/run.py --replot   # the table from results.csv
+    python3 benchmarks/failure_pushes/run.py --replot   # table and chart from results.csv
+    python3 benchmarks/failure_pushes/run.py --quick    # 2 short runs: the test-suite smoke run
 
 Pushes, each from a case that runs to one that does not (or to the end of
 the range), with the default numerics (explicit elastic coupling, DG 1 with
@@ -16,21 +17,35 @@ the limiter, adaptive time step):
                    inertia Re_b = 250, 500, 1000, 2000 (Ca = 0.3),
                    deformation Ca = 0.3, 1, 3 (Re_b = 250),
                    packing Phi = 0.1, 0.2, 0.3.
-Each row: finished or the solver's message, the smallest det B, the largest
-eigenvalue of B, the closest particle gap (in cells), the mass drift.
+Each row: finished or the solver's message, the time reached, the smallest
+det B, the closest particle gap (in cells), the mass drift. Writes
+results.csv and failure_pushes.png (time reached and smallest det B against
+each knob).
 """
 
 import concurrent.futures
 import csv
+import math
 import os
 import re
 import subprocess
 import sys
 import time
 
+try:
+    import matplotlib
+except ImportError:  # Debian's matplotlib lives in /usr/bin/python3
+    if os.path.realpath(sys.executable) != "/usr/bin/python3" and os.path.exists("/usr/bin/python3"):
+        os.execv("/usr/bin/python3", ["/usr/bin/python3"] + sys.argv)
+    raise
+matplotlib.use("Agg")
+import matplotlib.pyplot as plt  # noqa: E402
+
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
-WORK = os.environ.get("BENCHMARK_WORK", os.path.join(HERE, "work"))
+QUICK = "--quick" in sys.argv
+WORK = os.environ.get("BENCHMARK_WORK", os.path.join(HERE, "work_quick" if QUICK else "work"))
+OUT = WORK if QUICK else HERE
 SUSPENSION = os.environ.get("SUSPENSION", os.path.join(REPO, "build", "suspension"))
 PARALLEL = int(os.environ.get("JOBS", os.cpu_count() or 1))
 
@@ -42,6 +57,12 @@ CHANNEL_COMMON = ["Mesh refinement/Maximum level=6", "Time stepping/End time=0.3
 
 
 def cases():
+    if QUICK:
+        return [("particle", "Ca", 10, SHEAR, ["Solid/Shear modulus=0.1", "Time stepping/End time=0.2",
+                                                 "Mesh/Global refinements=4"]),
+                ("suspension", "Phi", 0.3, CHANNEL, CHANNEL_COMMON[1:] + [
+                    "Mesh refinement/Maximum level=5", "Time stepping/End time=0.01",
+                    "Solid/Seeding/Volume fraction=0.3"])]
     out = []
     for ca in (0.3, 1, 3, 10):
         # mu = 1, shear rate 1: G = 1 / Ca
@@ -94,9 +115,38 @@ def run(case):
     return row
 
 
+def plot(rows, path):
+    knobs = [("particle", "Ca"), ("suspension", "Re_b"), ("suspension", "Ca"),
+             ("suspension", "Phi")]
+    knobs = [k for k in knobs if any((r["scene"], r["knob"]) == k for r in rows)]
+    fig, axes = plt.subplots(2, len(knobs), figsize=(3.2 * len(knobs), 5.6), squeeze=False)
+    for col, (scene, knob) in enumerate(knobs):
+        sel = sorted([r for r in rows if (r["scene"], r["knob"]) == (scene, knob)],
+                     key=lambda r: float(r["value"]))
+        for row, key in enumerate(("t_reached", "min_det_B")):
+            ax = axes[row][col]
+            for r in sel:
+                y = float(r[key]) if r[key] else float("nan")
+                ok = r["outcome"] == "finished"
+                ax.plot(float(r["value"]), y, "o" if ok else "X", ms=9,
+                        color="tab:green" if ok else "tab:red")
+            ax.set_xscale("log")
+            ax.set_xlabel(knob)
+            ax.grid(True, which="both", alpha=0.3)
+            if col == 0:
+                ax.set_ylabel("time reached" if key == "t_reached" else "smallest det B")
+            if row == 0:
+                ax.set_title(scene, fontsize=9)
+    fig.suptitle("Pushes: green finished, red X stopped by a check", fontsize=10)
+    fig.tight_layout()
+    fig.savefig(path, dpi=110)
+    plt.close(fig)
+    print("wrote", path)
+
+
 def main():
     os.makedirs(WORK, exist_ok=True)
-    path = os.path.join(HERE, "results.csv")
+    path = os.path.join(OUT, "results.csv")
     start = time.perf_counter()
     if "--replot" in sys.argv:
         with open(path) as f:
@@ -117,7 +167,20 @@ def main():
             r["min_det_B"] or "-",
             r["closest_gap_cells"] or "-", {"yes": "no", "no": "YES"}.get(r["merged_free"], "-"),
             r["mass_drift"] or "-", r["wall_time"], r["message"]))
+    plot(rows, os.path.join(OUT, "failure_pushes.png"))
     print("benchmark wall time %.0f s" % (time.perf_counter() - start))
+    # every run either finishes with phi conserved or stops with one message
+    # naming what failed: never silent garbage
+    known = ("not symmetric positive definite", "phi left", "not finite", "diverged",
+             "collapsed", "too large for the transport", "could place only")
+    bad = [r for r in rows if (r["outcome"] == "finished" and not (
+        r["mass_drift"] and abs(float(r["mass_drift"])) < 1e-10)) or (
+        r["outcome"] == "failed" and not any(k in r["message"] for k in known))]
+    for r in bad:
+        print("unexplained outcome: %s %s=%s %s %s" % (r["scene"], r["knob"], r["value"],
+                                                        r["outcome"], r["message"]))
+    if QUICK:
+        sys.exit(1 if bad else 0)
 
 
 if __name__ == "__main__":
