@@ -25,24 +25,14 @@ import subprocess
 import sys
 import time
 
-try:
-    import matplotlib
-except ImportError:  # Debian's matplotlib lives in /usr/bin/python3
-    if os.path.realpath(sys.executable) != "/usr/bin/python3" and os.path.exists("/usr/bin/python3"):
-        os.execv("/usr/bin/python3", ["/usr/bin/python3"] + sys.argv)
-    raise
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
 WORK = os.path.join(HERE, "work")
 QUICK = "--quick" in sys.argv
 OUT = WORK if QUICK else HERE
 sys.path.insert(0, os.path.join(REPO, "scripts"))
+from benchmark_tools import plt, SUSPENSION, write_csv  # noqa: E402
 from statistics_table import read_table as read_statistics  # noqa: E402
-
-SUSPENSION = os.environ.get("SUSPENSION", os.path.join(REPO, "build", "suspension"))
 
 # (dim, kind, finest level); "reference" is adaptive
 CASES = ([(2, "uniform", l) for l in (4, 5, 6)] + [(2, "adaptive", l) for l in (4, 5, 6, 7)]
@@ -77,13 +67,6 @@ def run(dim, kind, level):
     print("  %-22s D = %.7f  cells (mean) %9.0f  wall %8.1f s" % (name, d, cells, wall), flush=True)
     return dict(dim=dim, kind=kind, level=level, cells_per_diameter=0.4 / h, D=d,
                 mean_cells=cells, steps=len(stats["cells"]), wall_time=wall)
-
-
-def write_csv(rows, path):
-    with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-        w.writeheader()
-        w.writerows(rows)
 
 
 def read_csv(path):

@@ -25,29 +25,20 @@ each knob).
 
 import concurrent.futures
 import csv
-import math
 import os
 import re
 import subprocess
 import sys
 import time
 
-try:
-    import matplotlib
-except ImportError:  # Debian's matplotlib lives in /usr/bin/python3
-    if os.path.realpath(sys.executable) != "/usr/bin/python3" and os.path.exists("/usr/bin/python3"):
-        os.execv("/usr/bin/python3", ["/usr/bin/python3"] + sys.argv)
-    raise
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
+sys.path.insert(0, os.path.join(REPO, "scripts"))
+from benchmark_tools import plt, SUSPENSION, PARALLEL, work_directory, write_csv  # noqa: E402
+
 QUICK = "--quick" in sys.argv
-WORK = os.environ.get("BENCHMARK_WORK", os.path.join(HERE, "work_quick" if QUICK else "work"))
+WORK = work_directory(HERE, QUICK)
 OUT = WORK if QUICK else HERE
-SUSPENSION = os.environ.get("SUSPENSION", os.path.join(REPO, "build", "suspension"))
-PARALLEL = int(os.environ.get("JOBS", os.cpu_count() or 1))
 
 SHEAR = os.path.join(REPO, "parameters", "disc_shear_2d.prm")
 CHANNEL = os.path.join(REPO, "parameters", "suspension_channel_2d.prm")
@@ -156,10 +147,7 @@ def main():
     else:
         with concurrent.futures.ThreadPoolExecutor(PARALLEL) as pool:
             rows = list(pool.map(run, cases()))
-        with open(path, "w", newline="") as f:
-            w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-            w.writeheader()
-            w.writerows(rows)
+        write_csv(rows, path)
     print("\n%-10s %-5s %6s %-9s %9s %10s %8s %7s %10s %7s  %s" % (
         "scene", "knob", "value", "outcome", "t reached", "min det B", "gap/dx", "merged",
         "drift", "wall", "message"))

@@ -34,25 +34,15 @@ import subprocess
 import sys
 import time
 
-try:
-    import matplotlib
-except ImportError:  # Debian's matplotlib lives in /usr/bin/python3
-    if os.path.realpath(sys.executable) != "/usr/bin/python3" and os.path.exists("/usr/bin/python3"):
-        os.execv("/usr/bin/python3", ["/usr/bin/python3"] + sys.argv)
-    raise
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
-QUICK = "--quick" in sys.argv
-WORK = os.environ.get("BENCHMARK_WORK", os.path.join(HERE, "work_quick" if QUICK else "work"))
-OUT = WORK if QUICK else HERE
 sys.path.insert(0, os.path.join(REPO, "scripts"))
+from benchmark_tools import plt, SUSPENSION, PARALLEL, work_directory, write_csv  # noqa: E402
 from statistics_table import read_table as read_statistics  # noqa: E402
 
-SUSPENSION = os.environ.get("SUSPENSION", os.path.join(REPO, "build", "suspension"))
-PARALLEL = int(os.environ.get("JOBS", os.cpu_count() or 1))
+QUICK = "--quick" in sys.argv
+WORK = work_directory(HERE, QUICK)
+OUT = WORK if QUICK else HERE
 
 RADIUS, SHEAR = 0.2, 1.0
 TOLERANCE = 0.05  # stable-and-accurate: |D / D_converged - 1| <= 5 %
@@ -195,13 +185,6 @@ FIELDS = ["scene", "scheme", "coupling", "degree", "limiter", "Ca", "Re", "mu", 
           "En", "class", "failure", "D", "D_converged", "steps", "wall_time"]
 
 
-def write_csv(rows, path):
-    with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=FIELDS, extrasaction="ignore")
-        w.writeheader()
-        w.writerows(rows)
-
-
 def read_csv(path):
     with open(path) as f:
         rows = list(csv.DictReader(f))
@@ -305,7 +288,7 @@ def main():
         with concurrent.futures.ThreadPoolExecutor(PARALLEL) as pool:
             rows = list(pool.map(run, cases))
         classify(rows)
-        write_csv(rows, csv_path)
+        write_csv(rows, csv_path, FIELDS)
     report(rows)
     plot(rows, OUT)
     print("benchmark wall time %.0f s" % (time.perf_counter() - start))

@@ -31,25 +31,15 @@ import subprocess
 import sys
 import time
 
-try:
-    import matplotlib
-except ImportError:  # Debian's matplotlib lives in /usr/bin/python3
-    if os.path.realpath(sys.executable) != "/usr/bin/python3" and os.path.exists("/usr/bin/python3"):
-        os.execv("/usr/bin/python3", ["/usr/bin/python3"] + sys.argv)
-    raise
-matplotlib.use("Agg")
-import matplotlib.pyplot as plt  # noqa: E402
-
 HERE = os.path.dirname(os.path.abspath(__file__))
 REPO = os.path.normpath(os.path.join(HERE, "..", ".."))
-QUICK = "--quick" in sys.argv
-WORK = os.environ.get("BENCHMARK_WORK", os.path.join(HERE, "work_quick" if QUICK else "work"))
-OUT = WORK if QUICK else HERE
 sys.path.insert(0, os.path.join(REPO, "scripts"))
+from benchmark_tools import plt, SUSPENSION, PARALLEL, work_directory, write_csv  # noqa: E402
 from statistics_table import read_table as read_statistics  # noqa: E402
 
-SUSPENSION = os.environ.get("SUSPENSION", os.path.join(REPO, "build", "suspension"))
-PARALLEL = int(os.environ.get("JOBS", os.cpu_count() or 1))
+QUICK = "--quick" in sys.argv
+WORK = work_directory(HERE, QUICK)
+OUT = WORK if QUICK else HERE
 REFERENCE = os.path.join(REPO, "benchmarks", "adaptivity", "work", "2d_reference_8", "statistics.txt")
 
 if QUICK:
@@ -131,13 +121,6 @@ def pareto(rows):
             front.append(r)
             best = r["error"]
     return front
-
-
-def write_csv(rows, path):
-    with open(path, "w", newline="") as f:
-        w = csv.DictWriter(f, fieldnames=list(rows[0].keys()))
-        w.writeheader()
-        w.writerows(rows)
 
 
 def read_csv(path, text_fields):

@@ -11,6 +11,58 @@ namespace Suspension::Fluid
 {
   namespace
   {
+    /// BoomerAMG for a momentum matrix.
+    PETScWrappers::PreconditionBoomerAMG::AdditionalData momentum_amg_data(const int  dim,
+                                                                           const bool symmetric)
+    {
+      PETScWrappers::PreconditionBoomerAMG::AdditionalData data;
+      data.symmetric_operator = symmetric;
+      data.strong_threshold   = dim == 2 ? 0.25 : 0.5;
+      // With small time steps the matrix is dominated by the mass matrix:
+      // few strong connections, so coarsening stalls early and hypre's
+      // default direct solve on the (then large) coarsest level dominates
+      // the cost. Smooth there instead.
+      data.relaxation_type_coarse =
+        PETScWrappers::PreconditionBoomerAMG::AdditionalData::RelaxationType::symmetricSORJacobi;
+      data.n_sweeps_coarse = 2;
+      return data;
+    }
+
+    /// A PETSc Krylov solve to `tolerance` relative to |b|; returns the
+    /// iterations (0 for b = 0).
+    template <typename Solver, typename Preconditioner>
+    unsigned int krylov_solve(const MatrixType                     &matrix,
+                              VectorType                           &x,
+                              const VectorType                     &b,
+                              const Preconditioner                 &preconditioner,
+                              const double                          tolerance,
+                              const MPI_Comm                        communicator,
+                              const typename Solver::AdditionalData &data = {})
+    {
+      const double norm = b.l2_norm();
+      if (norm == 0.)
+        {
+          x = 0.;
+          return 0;
+        }
+      SolverControl control(5000, tolerance * norm);
+      Solver        solver(control, communicator, data);
+      solver.solve(matrix, x, b, preconditioner);
+      return control.last_step();
+    }
+
+    template <typename Preconditioner>
+    unsigned int cg_solve(const MatrixType     &matrix,
+                          VectorType           &x,
+                          const VectorType     &b,
+                          const Preconditioner &preconditioner,
+                          const double          tolerance,
+                          const MPI_Comm        communicator)
+    {
+      return krylov_solve<PETScWrappers::SolverCG>(matrix, x, b, preconditioner, tolerance,
+                                                   communicator);
+    }
+
     /// One sparsity pattern for all the given matrices (building it is
     /// the expensive part of a mesh change).
     template <int dim>
@@ -166,41 +218,8 @@ namespace Suspension::Fluid
         return;
       }
     amg_momentum = std::make_unique<PETScWrappers::PreconditionBoomerAMG>();
-    PETScWrappers::PreconditionBoomerAMG::AdditionalData data;
-    data.symmetric_operator = true;
-    data.strong_threshold   = dim == 2 ? 0.25 : 0.5;
-    // With small time steps A is dominated by the mass matrix: few strong
-    // connections, so coarsening stalls early and hypre's default direct
-    // solve on the (then large) coarsest level dominates the cost. Smooth
-    // there instead.
-    data.relaxation_type_coarse =
-      PETScWrappers::PreconditionBoomerAMG::AdditionalData::RelaxationType::symmetricSORJacobi;
-    data.n_sweeps_coarse = 2;
-    amg_momentum->initialize(A, data);
+    amg_momentum->initialize(A, momentum_amg_data(dim, true));
   }
-
-  namespace
-  {
-    template <typename Preconditioner>
-    unsigned int cg_solve(const MatrixType     &matrix,
-                          VectorType           &x,
-                          const VectorType     &b,
-                          const Preconditioner &preconditioner,
-                          const double          tolerance,
-                          const MPI_Comm        communicator)
-    {
-      const double norm = b.l2_norm();
-      if (norm == 0.)
-        {
-          x = 0.;
-          return 0;
-        }
-      SolverControl              control(5000, tolerance * norm);
-      PETScWrappers::SolverCG    cg(control, communicator);
-      cg.solve(matrix, x, b, preconditioner);
-      return control.last_step();
-    }
-  } // namespace
 
   template <int dim>
   unsigned int FluidOperators<dim>::solve_momentum(VectorType &x, const VectorType &b,
@@ -215,30 +234,16 @@ namespace Suspension::Fluid
   void FluidOperators<dim>::prepare_step_matrix()
   {
     amg_step = std::make_unique<PETScWrappers::PreconditionBoomerAMG>();
-    PETScWrappers::PreconditionBoomerAMG::AdditionalData data;
-    data.symmetric_operator = false;
-    data.strong_threshold   = dim == 2 ? 0.25 : 0.5;
-    data.relaxation_type_coarse =
-      PETScWrappers::PreconditionBoomerAMG::AdditionalData::RelaxationType::symmetricSORJacobi;
-    data.n_sweeps_coarse = 2;
-    amg_step->initialize(A_step, data);
+    amg_step->initialize(A_step, momentum_amg_data(dim, false));
   }
 
   template <int dim>
   unsigned int FluidOperators<dim>::solve_step_matrix(VectorType &x, const VectorType &b,
                                                       const double tolerance) const
   {
-    const double norm = b.l2_norm();
-    if (norm == 0.)
-      {
-        x = 0.;
-        return 0;
-      }
-    SolverControl                control(5000, tolerance * norm);
-    PETScWrappers::SolverGMRES   gmres(control, communicator,
-                                     PETScWrappers::SolverGMRES::AdditionalData(50));
-    gmres.solve(A_step, x, b, *amg_step);
-    return control.last_step();
+    return krylov_solve<PETScWrappers::SolverGMRES>(A_step, x, b, *amg_step, tolerance,
+                                                    communicator,
+                                                    PETScWrappers::SolverGMRES::AdditionalData(50));
   }
 
   template <int dim>

@@ -435,6 +435,20 @@ namespace Suspension::Fluid
     std::vector<double>                  modulus(n_q);
     std::vector<SymmetricTensor<2, dim>> B(n_q);
     Vector<double>                       u_star_local(nu_dofs), lifted(nu_dofs);
+    FullMatrix<double>                   cell_E(nu_dofs, nu_dofs);
+    // (alpha/dt) M + nu K of the current cell: the lifting of boundary data
+    // and the semi-implicit step matrix need it
+    const auto assemble_cell_momentum_matrix = [&]() {
+      cell_matrix = 0;
+      for (unsigned int q = 0; q < n_q; ++q)
+        for (unsigned int i = 0; i < nu_dofs; ++i)
+          for (unsigned int j = 0; j < nu_dofs; ++j)
+            if (component[i] == component[j])
+              cell_matrix(i, j) += (operators.momentum_alpha_over_dt * fe_u.shape_value(i, q) *
+                                      fe_u.shape_value(j, q) +
+                                    nu * fe_u.shape_grad(i, q) * fe_u.shape_grad(j, q)) *
+                                   fe_u.JxW(q);
+    };
     for (unsigned int i = 0; i < nu_dofs; ++i)
       component[i] = space.fe_velocity.system_to_component_index(i).first;
     const double inv_rho = 1. / parameters.material.density;
@@ -491,20 +505,11 @@ namespace Suspension::Fluid
               for (const auto *s : sources)
                 elastic = s->elastic_stiffness(cell, space.quadrature.get_points(), modulus, B) ||
                           elastic;
-              cell_matrix = 0;
-              for (unsigned int q = 0; q < n_q; ++q)
-                for (unsigned int i = 0; i < nu_dofs; ++i)
-                  for (unsigned int j = 0; j < nu_dofs; ++j)
-                    if (component[i] == component[j])
-                      cell_matrix(i, j) +=
-                        (operators.momentum_alpha_over_dt * fe_u.shape_value(i, q) *
-                           fe_u.shape_value(j, q) +
-                         nu * fe_u.shape_grad(i, q) * fe_u.shape_grad(j, q)) *
-                        fe_u.JxW(q);
+              assemble_cell_momentum_matrix();
               if (elastic)
                 {
                   // E_ij = int G phi [delta_{ci cj} g_i.B g_j + (B g_j)_{ci} (g_i)_{cj}]
-                  FullMatrix<double> cell_E(nu_dofs, nu_dofs);
+                  cell_E = 0;
                   for (unsigned int q = 0; q < n_q; ++q)
                     {
                       const double w = theta * dt * inv_rho * modulus[q] * fe_u.JxW(q);
@@ -539,16 +544,7 @@ namespace Suspension::Fluid
             {
               // Lift the boundary data: the cell matrix moves A g to the
               // right-hand side (Dirichlet columns are not in A).
-              cell_matrix = 0;
-              for (unsigned int q = 0; q < n_q; ++q)
-                for (unsigned int i = 0; i < nu_dofs; ++i)
-                  for (unsigned int j = 0; j < nu_dofs; ++j)
-                    if (component[i] == component[j])
-                      cell_matrix(i, j) +=
-                        (operators.momentum_alpha_over_dt * fe_u.shape_value(i, q) *
-                           fe_u.shape_value(j, q) +
-                         nu * fe_u.shape_grad(i, q) * fe_u.shape_grad(j, q)) *
-                        fe_u.JxW(q);
+              assemble_cell_momentum_matrix();
               step_constraints.distribute_local_to_global(cell_rhs, dofs, rhs_u, cell_matrix);
             }
           else
