@@ -82,8 +82,11 @@ namespace Suspension::Fluid
                              DoFTools::always : DoFTools::none;
       DoFTools::make_sparsity_pattern(dof, coupling, dsp, constraints, false);
       SparsityTools::distribute_sparsity_pattern(dsp, owned, dof.get_communicator(), relevant);
-      for (auto *matrix : matrices)
-        matrix->reinit(owned, owned, dsp, dof.get_communicator());
+      // the first from the pattern, the others as copies of its structure
+      // (MatDuplicate: no second pass over the pattern)
+      matrices[0]->reinit(owned, owned, dsp, dof.get_communicator());
+      for (unsigned int m = 1; m < matrices.size(); ++m)
+        matrices[m]->reinit(*matrices[0]);
     }
   } // namespace
 
@@ -208,7 +211,9 @@ namespace Suspension::Fluid
       return;
     A.copy_from(K);
     A *= nu;
-    A.add(alpha_over_dt, M);
+    // MatrixBase::add() would assume different patterns and rebuild A
+    const PetscErrorCode ierr = MatAXPY(A, alpha_over_dt, M, SAME_NONZERO_PATTERN);
+    AssertThrow(ierr == 0, ExcPETScError(ierr));
     momentum_alpha_over_dt = alpha_over_dt;
     momentum_nu            = nu;
 

@@ -434,7 +434,11 @@ namespace Suspension::Fluid
     std::vector<unsigned int>            component(nu_dofs);
     std::vector<double>                  modulus(n_q);
     std::vector<SymmetricTensor<2, dim>> B(n_q);
-    Vector<double>                       u_star_local(nu_dofs), lifted(nu_dofs);
+    // the cell's DoF values, read once per vector: the FEValues views
+    // would each allocate and read them again
+    Vector<double> u_star_local(nu_dofs), u_history_local(nu_dofs), lifted(nu_dofs);
+    Vector<double> p_sharp_local(space.fe_pressure.n_dofs_per_cell());
+    const FEValuesExtractors::Scalar pressure(0);
     FullMatrix<double>                   cell_E(nu_dofs, nu_dofs);
     // (alpha/dt) M + nu K of the current cell: the lifting of boundary data
     // and the semi-implicit step matrix need it
@@ -458,12 +462,18 @@ namespace Suspension::Fluid
         {
           fe_u.reinit(cell);
           fe_p.reinit(FluidSpace<dim>::cell_of(cell, space.dof_pressure));
-          fe_u[velocities].get_function_values(u_history_ghosted, history);
-          fe_p.get_function_gradients(p_sharp_ghosted, grad_p);
+          cell->get_dof_values(u_history_ghosted, u_history_local);
+          fe_u[velocities].get_function_values_from_local_dof_values(make_array_view(u_history_local), history);
+          FluidSpace<dim>::cell_of(cell, space.dof_pressure)
+            ->get_dof_values(p_sharp_ghosted, p_sharp_local);
+          fe_p[pressure].get_function_gradients_from_local_dof_values(make_array_view(p_sharp_local), grad_p);
+          if (convection || semi_implicit)
+            cell->get_dof_values(u_star_ghosted, u_star_local);
           if (convection)
             {
-              fe_u[velocities].get_function_values(u_star_ghosted, u_star);
-              fe_u[velocities].get_function_gradients(u_star_ghosted, grad_u_star);
+              fe_u[velocities].get_function_values_from_local_dof_values(make_array_view(u_star_local), u_star);
+              fe_u[velocities].get_function_gradients_from_local_dof_values(make_array_view(u_star_local),
+                                                                           grad_u_star);
             }
           std::fill(force.begin(), force.end(), Tensor<1, dim>());
           std::fill(stress.begin(), stress.end(), SymmetricTensor<2, dim>());
@@ -528,7 +538,6 @@ namespace Suspension::Fluid
                             }
                         }
                     }
-                  cell->get_dof_values(u_star_ghosted, u_star_local);
                   cell_E.vmult(lifted, u_star_local);
                   cell_rhs += lifted;
                   cell_matrix.add(1., cell_E);
@@ -562,13 +571,15 @@ namespace Suspension::Fluid
     const FEValuesExtractors::Vector velocities(0);
     FEValues<dim> fe_u(space.fe_velocity, space.quadrature, update_values | update_JxW_values);
     std::vector<Tensor<1, dim>> values(space.quadrature.size());
+    Vector<double>              local(space.fe_velocity.n_dofs_per_cell());
     const double degree = space.fe_velocity.degree;
     double energy = 0., speed_over_h = 0., speed = 0.;
     for (const auto &cell : space.dof_velocity.active_cell_iterators())
       if (cell->is_locally_owned())
         {
           fe_u.reinit(cell);
-          fe_u[velocities].get_function_values(velocity_ghosted, values);
+          cell->get_dof_values(velocity_ghosted, local);
+          fe_u[velocities].get_function_values_from_local_dof_values(make_array_view(local), values);
           double cell_speed = 0.;
           for (const unsigned int q : fe_u.quadrature_point_indices())
             {

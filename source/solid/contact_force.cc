@@ -5,6 +5,7 @@
 
 #include <suspension/mesh/face_neighbours.h>
 #include <suspension/solid/contact_force.h>
+#include <suspension/solid/phi_values.h>
 
 #include <algorithm>
 #include <cmath>
@@ -252,16 +253,14 @@ namespace Suspension::Solid
     std::vector<Point<dim>> unit_vertices;
     for (const unsigned int v : GeometryInfo<dim>::vertex_indices())
       unit_vertices.push_back(GeometryInfo<dim>::unit_cell_vertex(v));
-    FEValues<dim>       vertex_values(dof_handler.get_fe(), Quadrature<dim>(unit_vertices),
-                                      update_values);
-    std::vector<double> phi(unit_vertices.size());
+    PhiValues<dim> vertex_values(solid.get_fe(), Quadrature<dim>(unit_vertices), update_default);
+    const auto    &phi = vertex_values.values();
 
     std::vector<SurfacePoint> points;
     for (const auto &dof_cell : dof_handler.active_cell_iterators())
       if (dof_cell->is_locally_owned())
         {
-          vertex_values.reinit(dof_cell);
-          vertex_values[FEValuesExtractors::Scalar(0)].get_function_values(phi_solution, phi);
+          vertex_values.reinit(dof_cell, phi_solution);
           const Cell   cell(dof_cell);
           const double lo = *std::min_element(phi.begin(), phi.end());
           const double hi = *std::max_element(phi.begin(), phi.end());
@@ -312,16 +311,15 @@ namespace Suspension::Solid
     const MPI_Comm communicator = ptria->get_communicator();
 
     // cell means of phi
-    const QGauss<dim>   quadrature(dof_handler.get_fe().degree + 1);
-    FEValues<dim>       fe_values(dof_handler.get_fe(), quadrature,
-                                  update_values | update_JxW_values);
-    std::vector<double> phi(quadrature.size());
+    PhiValues<dim> phi_values(solid.get_fe(), QGauss<dim>(solid.get_fe().degree + 1),
+                              update_JxW_values);
+    const auto    &fe_values = phi_values.fe_values();
+    const auto    &phi       = phi_values.values();
     std::vector<double> cell_mean(tria.n_active_cells(), 0.);
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
-          fe_values.reinit(cell);
-          fe_values[FEValuesExtractors::Scalar(0)].get_function_values(solid.get_solution(), phi);
+          phi_values.reinit(cell, solid.get_solution());
           double integral = 0., measure = 0.;
           for (const unsigned int q : fe_values.quadrature_point_indices())
             {

@@ -8,6 +8,7 @@
 
 #include <suspension/core/scene.h>
 #include <suspension/postprocess/point_values.h>
+#include <suspension/solid/phi_values.h>
 #include <suspension/solid/solid_phase.h>
 
 #include <cmath>
@@ -201,16 +202,13 @@ namespace Suspension::Solid
   std::vector<unsigned char> SolidPhase<dim>::classify_cells(const double epsilon) const
   {
     std::vector<unsigned char> phase(dof_handler.get_triangulation().n_active_cells(), fluid_cell);
-    const QGauss<dim>                    quadrature(fe.degree + 1);
-    FEValues<dim>                        fe_values(fe, quadrature, update_values | update_JxW_values);
-    const FEValuesExtractors::Scalar     phi_x(0);
-    std::vector<double>                  phi(quadrature.size());
-    std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
+    PhiValues<dim> phi_values(fe, QGauss<dim>(fe.degree + 1), update_JxW_values);
+    const auto    &fe_values = phi_values.fe_values();
+    const auto    &phi       = phi_values.values();
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
-          fe_values.reinit(cell);
-          fe_values[phi_x].get_function_values(solution, phi);
+          phi_values.reinit(cell, solution);
           double lo = 1., hi = 0., mean = 0., measure = 0.;
           for (const unsigned int q : fe_values.quadrature_point_indices())
             {
@@ -219,13 +217,11 @@ namespace Suspension::Solid
               mean += phi[q] * fe_values.JxW(q);
               measure += fe_values.JxW(q);
             }
-          cell->get_dof_indices(dofs);
-          for (unsigned int i = 0; i < dofs.size(); ++i)
-            if (fe.system_to_component_index(i).first == 0)
-              {
-                lo = std::min(lo, solution(dofs[i]));
-                hi = std::max(hi, solution(dofs[i]));
-              }
+          for (const double value : phi_values.dof_values())
+            {
+              lo = std::min(lo, value);
+              hi = std::max(hi, value);
+            }
           // a value inside (epsilon, 1 - epsilon), or values on both sides
           const bool inside_range = hi > epsilon && lo < 1. - epsilon;
           auto &p = phase[cell->active_cell_index()];
@@ -334,47 +330,53 @@ namespace Suspension::Solid
   {
     SolidDiagnostics d;
     const QGauss<dim>  quadrature(fe.degree + 2);
-    FEValues<dim>      fe_values(fe, quadrature,
-                            update_values | update_JxW_values | update_quadrature_points);
-    const unsigned int nc = fe.n_components();
+    // phi on every cell through its own scalar element; the system's
+    // FEValues (for B) only on cells that hold solid
+    PhiValues<dim>     phi_values(fe, quadrature, update_JxW_values);
+    FEValues<dim>      fe_values(fe, quadrature, update_values | update_quadrature_points);
+    const auto        &phi = phi_values.values();
+    const unsigned int nc  = fe.n_components();
     Point<dim>         worst;
     std::vector<Vector<double>> values(quadrature.size(), Vector<double>(nc));
     double volume = 0., lo = 1e300, hi = -1e300, det_min = 1e300, eig_min = 1e300, eig_max = 1.;
-    std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
+          phi_values.reinit(cell, solution);
+          bool solid = false;
+          for (const unsigned int q : phi_values.fe_values().quadrature_point_indices())
+            {
+              volume += phi[q] * phi_values.fe_values().JxW(q);
+              lo    = std::min(lo, phi[q]);
+              hi    = std::max(hi, phi[q]);
+              solid = solid || phi[q] >= solid_threshold;
+            }
+          // nodal values too: the limiter's bounds hold there as well
+          for (const double value : phi_values.dof_values())
+            {
+              lo = std::min(lo, value);
+              hi = std::max(hi, value);
+            }
+          // B means something only where there is solid
+          if (nc == 1 || !solid)
+            continue;
           fe_values.reinit(cell);
           fe_values.get_function_values(solution, values);
           for (const unsigned int q : fe_values.quadrature_point_indices())
-            {
-              volume += values[q][0] * fe_values.JxW(q);
-              lo = std::min(lo, values[q][0]);
-              hi = std::max(hi, values[q][0]);
-              // B means something only where there is solid
-              if (nc > 1 && values[q][0] >= solid_threshold)
-                {
-                  SymmetricTensor<2, dim> B;
-                  for (unsigned int c = 0; c < n_B; ++c)
-                    B[SymmetricTensor<2, dim>::unrolled_to_component_indices(c)] = values[q][1 + c];
-                  det_min = std::min(det_min, determinant(B));
-                  const double smallest = smallest_eigenvalue(B);
-                  // exact in 2D, an upper bound in 3D (the others are >= smallest)
-                  eig_max = std::max(eig_max, trace(B) - (dim - 1) * smallest);
-                  if (smallest < eig_min || !std::isfinite(smallest))
-                    {
-                      eig_min = smallest;
-                      worst   = fe_values.quadrature_point(q);
-                    }
-                }
-            }
-          // nodal values too: the limiter's bounds hold there as well
-          cell->get_dof_indices(dofs);
-          for (unsigned int i = 0; i < dofs.size(); ++i)
-            if (fe.system_to_component_index(i).first == 0)
+            if (phi[q] >= solid_threshold)
               {
-                lo = std::min(lo, solution(dofs[i]));
-                hi = std::max(hi, solution(dofs[i]));
+                SymmetricTensor<2, dim> B;
+                for (unsigned int c = 0; c < n_B; ++c)
+                  B[SymmetricTensor<2, dim>::unrolled_to_component_indices(c)] = values[q][1 + c];
+                det_min = std::min(det_min, determinant(B));
+                const double smallest = smallest_eigenvalue(B);
+                // exact in 2D, an upper bound in 3D (the others are >= smallest)
+                eig_max = std::max(eig_max, trace(B) - (dim - 1) * smallest);
+                if (smallest < eig_min || !std::isfinite(smallest))
+                  {
+                    eig_min = smallest;
+                    worst   = fe_values.quadrature_point(q);
+                  }
               }
         }
     const MPI_Comm comm = dof_handler.get_communicator();
@@ -393,6 +395,19 @@ namespace Suspension::Solid
           d.worst_B_location[c] = where[c];
       }
     return d;
+  }
+
+  template <int dim>
+  bool SolidPhase<dim>::holds_only_fluid(const Vector<double> &values) const
+  {
+    for (unsigned int i = 0; i < values.size(); ++i)
+      {
+        const unsigned int c = fe.system_to_component_index(i).first;
+        if (c == 0 ? std::abs(values[i]) >= fluid_threshold :
+                     values[i] != (c <= dim ? 1. : 0.))
+          return false;
+      }
+    return true;
   }
 
   template <int dim>
@@ -558,12 +573,25 @@ namespace Suspension::Solid
   {
     if (!pushes_fluid())
       return;
+    // Most cells hold fluid only: phi ~ 0 and B = I (reset_B_in_fluid), so
+    // G phi (B - I) is exactly zero there and the cell is skipped.
+    const auto solid_cell = Fluid::FluidSpace<dim>::cell_of(cell, dof_handler);
+    cell_values.reinit(fe.n_dofs_per_cell());
+    solid_cell->get_dof_values(solution, cell_values);
+    if (!body_force && holds_only_fluid(cell_values))
+      return;
     if (!stress_values || stress_values->n_quadrature_points != unit_points.size())
       stress_values = std::make_unique<FEValues<dim>>(fe, Quadrature<dim>(unit_points), update_values);
-    stress_values->reinit(Fluid::FluidSpace<dim>::cell_of(cell, dof_handler));
+    stress_values->reinit(solid_cell);
     point_values.resize(unit_points.size(), Vector<double>(fe.n_components()));
     auto &values = point_values;
-    stress_values->get_function_values(solution, values);
+    for (unsigned int q = 0; q < unit_points.size(); ++q)
+      {
+        values[q] = 0.;
+        for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
+          values[q][fe.system_to_component_index(i).first] +=
+            cell_values[i] * stress_values->shape_value(i, q);
+      }
     if (body_force)
       {
         body_force->set_time(time);

@@ -154,6 +154,9 @@ namespace Suspension::Solid
     void reinit_discretization(const Fluid::FluidSpace<dim> &fluid_space);
     void check_B(const SolidDiagnostics &d, double time) const;
     void reset_B_in_fluid();
+    /// phi below fluid_threshold and B = I at every node of the cell
+    /// (values: the cell's DoF values): no stress.
+    bool holds_only_fluid(const Vector<double> &values) const;
 
     /// B is checked (SPD) where phi is at least this.
     static constexpr double solid_threshold = 0.1;
@@ -169,6 +172,7 @@ namespace Suspension::Solid
     double                 initial_volume = 0., time = 0.;
     mutable std::unique_ptr<FEValues<dim>> stress_values;
     mutable std::vector<Vector<double>>    point_values; // reused: add() runs on every cell
+    mutable Vector<double>                 cell_values;
     std::unique_ptr<Function<dim>>         body_force; // null: none
     std::unique_ptr<parallel::distributed::SolutionTransfer<dim, VectorType>> transfer;
   };
