@@ -569,7 +569,8 @@ namespace Suspension::Parameters
                       "1e-10",
                       Patterns::Double(1e-16, 1e-2),
                       "Relative residual reduction asked of every linear "
-                      "solve (CG with BoomerAMG).");
+                      "solve of the fluid step (momentum, pressure increment, "
+                      "pressure mass matrix).");
     prm.declare_entry("Momentum preconditioner",
                       "amg",
                       Patterns::Selection("amg|jacobi"),
