@@ -460,12 +460,12 @@ namespace Suspension::Fluid
     for (const auto &cell : space.dof_velocity.active_cell_iterators())
       if (cell->is_locally_owned())
         {
+          const auto pressure_cell = FluidSpace<dim>::cell_of(cell, space.dof_pressure);
           fe_u.reinit(cell);
-          fe_p.reinit(FluidSpace<dim>::cell_of(cell, space.dof_pressure));
+          fe_p.reinit(pressure_cell);
           cell->get_dof_values(u_history_ghosted, u_history_local);
           fe_u[velocities].get_function_values_from_local_dof_values(make_array_view(u_history_local), history);
-          FluidSpace<dim>::cell_of(cell, space.dof_pressure)
-            ->get_dof_values(p_sharp_ghosted, p_sharp_local);
+          pressure_cell->get_dof_values(p_sharp_ghosted, p_sharp_local);
           fe_p[pressure].get_function_gradients_from_local_dof_values(make_array_view(p_sharp_local), grad_p);
           if (convection || semi_implicit)
             cell->get_dof_values(u_star_ghosted, u_star_local);

@@ -398,6 +398,27 @@ namespace Suspension::Solid
   }
 
   template <int dim>
+  const std::vector<Vector<double>> &
+  SolidPhase<dim>::values_at(const typename DoFHandler<dim>::active_cell_iterator &solid_cell,
+                             const std::vector<Point<dim>> &unit_points) const
+  {
+    if (!stress_values || stress_values->n_quadrature_points != unit_points.size())
+      stress_values = std::make_unique<FEValues<dim>>(fe, Quadrature<dim>(unit_points), update_values);
+    stress_values->reinit(solid_cell);
+    point_values.resize(unit_points.size(), Vector<double>(fe.n_components()));
+    // summed from cell_values in the order get_function_values uses, without
+    // its per-call allocation and vector read
+    for (unsigned int q = 0; q < unit_points.size(); ++q)
+      {
+        point_values[q] = 0.;
+        for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
+          point_values[q][fe.system_to_component_index(i).first] +=
+            cell_values[i] * stress_values->shape_value(i, q);
+      }
+    return point_values;
+  }
+
+  template <int dim>
   bool SolidPhase<dim>::holds_only_fluid(const Vector<double> &values) const
   {
     for (unsigned int i = 0; i < values.size(); ++i)
@@ -580,18 +601,7 @@ namespace Suspension::Solid
     solid_cell->get_dof_values(solution, cell_values);
     if (!body_force && holds_only_fluid(cell_values))
       return;
-    if (!stress_values || stress_values->n_quadrature_points != unit_points.size())
-      stress_values = std::make_unique<FEValues<dim>>(fe, Quadrature<dim>(unit_points), update_values);
-    stress_values->reinit(solid_cell);
-    point_values.resize(unit_points.size(), Vector<double>(fe.n_components()));
-    auto &values = point_values;
-    for (unsigned int q = 0; q < unit_points.size(); ++q)
-      {
-        values[q] = 0.;
-        for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
-          values[q][fe.system_to_component_index(i).first] +=
-            cell_values[i] * stress_values->shape_value(i, q);
-      }
+    const auto &values = values_at(solid_cell, unit_points);
     if (body_force)
       {
         body_force->set_time(time);
@@ -619,13 +629,11 @@ namespace Suspension::Solid
   {
     if (!parameters.solid.semi_implicit || fe.n_components() == 1)
       return false;
-    if (!stress_values || stress_values->n_quadrature_points != unit_points.size())
-      stress_values = std::make_unique<FEValues<dim>>(fe, Quadrature<dim>(unit_points), update_values);
-    stress_values->reinit(Fluid::FluidSpace<dim>::cell_of(cell, dof_handler));
-    point_values.resize(unit_points.size(), Vector<double>(fe.n_components()));
-    auto &values = point_values;
-    stress_values->get_function_values(solution, values);
-    const double G = parameters.solid.shear_modulus;
+    const auto solid_cell = Fluid::FluidSpace<dim>::cell_of(cell, dof_handler);
+    cell_values.reinit(fe.n_dofs_per_cell());
+    solid_cell->get_dof_values(solution, cell_values);
+    const auto  &values = values_at(solid_cell, unit_points);
+    const double G      = parameters.solid.shear_modulus;
     for (unsigned int q = 0; q < unit_points.size(); ++q)
       {
         modulus[q] = G * values[q][0];

@@ -157,6 +157,11 @@ namespace Suspension::Solid
     /// phi below fluid_threshold and B = I at every node of the cell
     /// (values: the cell's DoF values): no stress.
     bool holds_only_fluid(const Vector<double> &values) const;
+    /// phi and B at unit_points of solid_cell, from cell_values (the
+    /// cell's DoF values, read by the caller)
+    const std::vector<Vector<double>> &
+    values_at(const typename DoFHandler<dim>::active_cell_iterator &solid_cell,
+              const std::vector<Point<dim>>                         &unit_points) const;
 
     /// B is checked (SPD) where phi is at least this.
     static constexpr double solid_threshold = 0.1;
@@ -172,7 +177,7 @@ namespace Suspension::Solid
     double                 initial_volume = 0., time = 0.;
     mutable std::unique_ptr<FEValues<dim>> stress_values;
     mutable std::vector<Vector<double>>    point_values; // reused: add() runs on every cell
-    mutable Vector<double>                 cell_values;
+    mutable Vector<double>                 cell_values; // of the cell add() works on
     std::unique_ptr<Function<dim>>         body_force; // null: none
     std::unique_ptr<parallel::distributed::SolutionTransfer<dim, VectorType>> transfer;
   };
