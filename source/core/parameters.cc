@@ -617,9 +617,10 @@ namespace Suspension::Parameters
                       Patterns::Selection("none|particles|random particles|function"),
                       "Initial solid volume fraction phi: none (no solid, "
                       "no phi or B is allocated), particles (the list in "
-                      "'Particles' with a smoothed edge), random particles "
+                      "'Particles'), random particles "
                       "(placed as the 'Seeding' subsection asks), or "
-                      "function.");
+                      "function; see 'Interface width' for how the edge is "
+                      "represented.");
     prm.declare_entry("Particles",
                       "",
                       Patterns::Anything(),
@@ -629,9 +630,13 @@ namespace Suspension::Parameters
     prm.declare_entry("Interface width",
                       std::to_string(d.interface_width),
                       Patterns::Double(0., 20.),
-                      "Width of the smoothed particle edge in cells of the "
-                      "finest level: phi = (1 - tanh(2 (|x - c| - r) / "
-                      "(width h))) / 2.");
+                      "0: the initial phi of every cell has the exact volume "
+                      "fraction of the particles as its mean (circle- or "
+                      "sphere-cell intersection; an expression: adaptive "
+                      "quadrature), the L2 projection of the sharp shape "
+                      "within the cell. Positive: a smoothed particle edge of "
+                      "this width in cells of the finest level, phi = (1 - "
+                      "tanh(2 (|x - c| - r) / (width h))) / 2, interpolated.");
     prm.declare_entry("Function constants",
                       "",
                       Patterns::Anything(),
@@ -678,6 +683,19 @@ namespace Suspension::Parameters
                       "predictor (Crank-Nicolson weight), which lifts the "
                       "elastic-wave limit at the price of a momentum matrix "
                       "and preconditioner per step (doc/method.md).");
+    prm.declare_entry("Stress weight", "sharp", Patterns::Selection("sharp|phi"),
+                      "Share H(phi) of the stress G H(phi) (B - I) a point "
+                      "carries. sharp: a smooth step from 0 at phi = 1/2 - w/2 "
+                      "to 1 at 1/2 + w/2 ('Stress weight width' w), B reset to "
+                      "I wherever H = 0, so the solid ends at phi = 1/2 - w/2 "
+                      "and no stress builds up in the diffuse tail of phi. "
+                      "phi: the paper's H = phi, B reset only in cells with "
+                      "phi < 1e-4 at every node (doc/method.md, 'Where the "
+                      "solid ends').");
+    prm.declare_entry("Stress weight width", std::to_string(d.stress_weight_width),
+                      Patterns::Double(0., 1.),
+                      "Range of phi around 1/2 across which the sharp stress "
+                      "weight rises from 0 to 1.");
     prm.declare_entry("Body force", zero_vector(dim), Patterns::Anything(),
                       "Force per unit volume of solid g(x, y[, z], t), one "
                       "expression per component separated by ';', applied as "
@@ -747,6 +765,8 @@ namespace Suspension::Parameters
     transport_cfl       = prm.get_double("Transport CFL");
     elastic_number      = prm.get_double("Elastic number");
     semi_implicit       = prm.get("Elastic coupling") == "semi-implicit";
+    sharp_stress        = prm.get("Stress weight") == "sharp";
+    stress_weight_width = prm.get_double("Stress weight width");
     body_force          = {prm.get("Body force"), constants};
     const std::string list = prm.get("Particles");
     prm.enter_subsection("Seeding");

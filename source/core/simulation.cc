@@ -396,7 +396,7 @@ namespace Suspension
       {
         const double elastic = parameters.solid.elastic_number * smallest_cell_size /
                                std::sqrt(parameters.solid.shear_modulus *
-                                         std::max(1., solid_diagnostics.max_eigenvalue_B) /
+                                         std::max(1., solid_diagnostics.wave_stiffness) /
                                          parameters.material.density);
         if (next > elastic)
           next = 0.9 * elastic;
@@ -544,13 +544,16 @@ namespace Suspension
     statistics.add_value("limited_cells", d.limited_cells);
     statistics.add_value("bad_means", d.out_of_bound_means);
     statistics.add_value("substeps", d.substeps);
-    std::vector<std::string> columns = {"solid_volume", "volume_drift", "phi_min", "phi_max"};
+    statistics.add_value("interface_cells", d.interface_width);
+    std::vector<std::string> columns = {"solid_volume", "volume_drift", "phi_min", "phi_max",
+                                        "interface_cells"};
     if (parameters.solid.elastic())
       {
         statistics.add_value("detB_min", d.min_det_B);
         statistics.add_value("eigB_min", d.min_eigenvalue_B);
         statistics.add_value("eigB_max", d.max_eigenvalue_B);
-        columns.insert(columns.end(), {"detB_min", "eigB_min", "eigB_max"});
+        statistics.add_value("tail_energy_share", d.tail_energy_share);
+        columns.insert(columns.end(), {"detB_min", "eigB_min", "eigB_max", "tail_energy_share"});
         static const char *where[] = {"eigB_min_x", "eigB_min_y", "eigB_min_z"};
         for (unsigned int c = 0; c < dim; ++c)
           {
@@ -643,6 +646,47 @@ namespace Suspension
   }
 
   template <int dim>
+  void Simulation<dim>::report_solid_probes()
+  {
+    const auto &v = parameters.verification;
+    if (!v.exact_solid_at_probes.empty() && !parameters.output.probe_points.empty())
+      {
+        auto exact = make_function<dim>({v.exact_solid_at_probes, v.exact_velocity.constants},
+                                        1 + Solid::SolidPhase<dim>::n_B);
+        exact->set_time(fluid.time());
+        double worst = 0., worst_strain = 0.;
+        for (const auto &c : parameters.output.probe_points)
+          {
+            Point<dim> p;
+            for (unsigned int d = 0; d < dim; ++d)
+              p[d] = c[d];
+            const auto values = solid->values_at({p});
+            double     difference = 0., strain = 0.;
+            for (unsigned int k = 0; k < values[0].size(); ++k)
+              {
+                const double e = exact->value(p, k);
+                worst = std::max(worst, std::abs(values[0][k] - e) / std::max(1., std::abs(e)));
+                if (k == 0)
+                  continue;
+                // off-diagonal entries count twice in the Frobenius norm
+                const double w = k <= dim ? 1. : 2.;
+                difference += w * Utilities::fixed_power<2>(values[0][k] - e);
+                strain += w * Utilities::fixed_power<2>(e - (k <= dim ? 1. : 0.));
+              }
+            if (strain > 1e-20)
+              worst_strain = std::max(worst_strain, std::sqrt(difference / strain));
+          }
+        pcout << "  solid fields at probes: largest relative error " << std::scientific
+              << std::setprecision(2) << worst << ", of B - I " << worst_strain
+              << std::defaultfloat << std::endl;
+        worst = std::max(worst, worst_strain);
+        if (v.tolerance > 0)
+          pcout << "  <= " << v.tolerance << ": " << (worst <= v.tolerance ? "yes" : "no")
+                << std::endl;
+      }
+  }
+
+  template <int dim>
   void Simulation<dim>::report_solid()
   {
     const auto &d = solid_diagnostics;
@@ -656,36 +700,18 @@ namespace Suspension
     if (parameters.solid.elastic())
       pcout << "  B: min det " << std::scientific << std::setprecision(6) << d.min_det_B
             << ", min eigenvalue " << d.min_eigenvalue_B << std::defaultfloat << std::endl;
+    pcout << "  interface: " << std::fixed << std::setprecision(2) << d.interface_width
+          << " cells across 0.01 < phi < 0.99";
+    if (parameters.solid.elastic())
+      pcout << ", elastic energy where phi < 1/2: " << std::scientific << std::setprecision(2)
+            << 100. * d.tail_energy_share << " %";
+    pcout << std::defaultfloat << std::endl;
     if (parameters.solid.particles.size() == 1)
       {
         pcout << "  final: " << describe(solid->particle_shape(space, fluid.velocity()))
               << std::endl;
       }
-    const auto &v = parameters.verification;
-    if (!v.exact_solid_at_probes.empty() && !parameters.output.probe_points.empty())
-      {
-        auto exact = make_function<dim>({v.exact_solid_at_probes, v.exact_velocity.constants},
-                                        1 + Solid::SolidPhase<dim>::n_B);
-        exact->set_time(fluid.time());
-        double worst = 0.;
-        for (const auto &c : parameters.output.probe_points)
-          {
-            Point<dim> p;
-            for (unsigned int d = 0; d < dim; ++d)
-              p[d] = c[d];
-            const auto values = solid->values_at({p});
-            for (unsigned int k = 0; k < values[0].size(); ++k)
-              {
-                const double e = exact->value(p, k);
-                worst = std::max(worst, std::abs(values[0][k] - e) / std::max(1., std::abs(e)));
-              }
-          }
-        pcout << "  solid fields at probes: largest relative error " << std::scientific
-              << std::setprecision(2) << worst << std::defaultfloat << std::endl;
-        if (v.tolerance > 0)
-          pcout << "  <= " << v.tolerance << ": " << (worst <= v.tolerance ? "yes" : "no")
-                << std::endl;
-      }
+    report_solid_probes();
     if (!parameters.verification.exact_fraction.empty())
       {
         const auto exact = make_function<dim>(
@@ -727,7 +753,8 @@ namespace Suspension
     std::optional<Postprocess::SolidFields<dim>> solid_fields;
     if (solid)
       solid_fields.emplace(Postprocess::SolidFields<dim>{
-        solid->get_dof_handler(), solid->get_solution(), parameters.solid.shear_modulus});
+        solid->get_dof_handler(), solid->get_solution(), parameters.solid.shear_modulus,
+        Solid::StressWeight(parameters.solid)});
     channel_statistics->sample(space, fluid.velocity(), fluid.time(), driving_force,
                                solid_fields ? &*solid_fields : nullptr,
                                contact.get());
@@ -837,6 +864,19 @@ namespace Suspension
           << space.dof_velocity.n_dofs() << " velocity + " << space.dof_pressure.n_dofs()
           << " pressure DoFs" << std::endl;
     report_seeding();
+    if (solid && !resuming && solid->initial_fraction_report().cut_cells > 0)
+      {
+        const auto &r = solid->initial_fraction_report();
+        pcout << "  initial phi: cell means = exact volume fractions, "
+              << r.cut_cells << " cut cells";
+        if (r.exact_volume > 0.)
+          pcout << "; volume " << std::scientific << std::setprecision(10)
+                << solid->diagnostics().volume << ", of the particles " << r.exact_volume
+                << std::setprecision(1) << " (relative difference "
+                << std::abs(solid->diagnostics().volume / r.exact_volume - 1.) << ")"
+                << std::defaultfloat;
+        pcout << std::endl;
+      }
 
     std::vector<const Fluid::MomentumSource<dim> *> sources;
     if (body_force)
@@ -969,6 +1009,8 @@ namespace Suspension
           if (std::abs(t - fluid.time()) < 1e-9 * dt)
             {
               report_errors(fluid.time(), false);
+              if (solid)
+                report_solid_probes();
               if (solid && parameters.solid.particles.size() == 1)
                 pcout << "  t = " << fluid.time() << ": "
                       << describe(solid->particle_shape(space, fluid.velocity())) << std::endl;

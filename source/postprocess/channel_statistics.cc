@@ -262,9 +262,9 @@ namespace Suspension::Postprocess
                     {
                       const auto  &B    = s_q[q];
                       const double B_zz = dim == 3 ? B[B_index(Z, Z)] : 1.;
-                      I[elastic] += G * phi_q * B[B_index(0, Y)] * dV;
-                      n1 += G * phi_q * (B[B_index(0, 0)] - B[B_index(Y, Y)]);
-                      n2 += G * phi_q * (B[B_index(Y, Y)] - B_zz);
+                      I[elastic] += G * solid->weight(phi_q) * B[B_index(0, Y)] * dV;
+                      n1 += G * solid->weight(phi_q) * (B[B_index(0, 0)] - B[B_index(Y, Y)]);
+                      n2 += G * solid->weight(phi_q) * (B[B_index(Y, Y)] - B_zz);
                     }
                 }
               local[n_bins * n_integrated] += U[0] * dV;

@@ -37,6 +37,18 @@ namespace Suspension::Solid
       }
   }
 
+  template <int dim>
+  void PhiValues<dim>::gradients(std::vector<Tensor<1, dim>> &grad) const
+  {
+    grad.resize(phi_at_points.size());
+    for (unsigned int q = 0; q < grad.size(); ++q)
+      {
+        grad[q] = Tensor<1, dim>();
+        for (unsigned int i = 0; i < phi_dofs.size(); ++i)
+          grad[q] += phi_dofs[i] * scalar.shape_grad(i, q);
+      }
+  }
+
   template class PhiValues<2>;
   template class PhiValues<3>;
 } // namespace Suspension::Solid

@@ -2,6 +2,7 @@
 #include <deal.II/base/symmetric_tensor.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_dgq.h>
+#include <deal.II/fe/fe_interface_values.h>
 #include <deal.II/fe/fe_values.h>
 #include <deal.II/lac/read_write_vector.h>
 #include <deal.II/numerics/vector_tools.h>
@@ -83,6 +84,7 @@ namespace Suspension::Solid
   SolidPhase<dim>::SolidPhase(const Parameters::All                           &parameters,
                               const parallel::distributed::Triangulation<dim> &tria)
     : parameters(parameters)
+    , weight(parameters.solid)
     , fe(make_fe<dim>(parameters.solid))
     , dof_handler(tria)
   {
@@ -131,6 +133,10 @@ namespace Suspension::Solid
     VectorTools::interpolate(dof_handler,
                              InitialSolid<dim>(parameters, fe.n_components(), interface_h),
                              solution);
+    // exact cell fractions of the sharp shape (expressions: always)
+    if (parameters.solid.interface_width == 0. ||
+        parameters.solid.initial_fraction == Parameters::InitialFraction::function)
+      initial_report = project_initial_fraction(parameters, dof_handler, solution);
     if (parameters.solid.limiter)
       transport.limit(solution, true);
     initial_volume = diagnostics().volume;
@@ -326,70 +332,176 @@ namespace Suspension::Solid
   }
 
   template <int dim>
+  double SolidPhase<dim>::face_variation(const typename DoFHandler<dim>::active_cell_iterator &cell,
+                                         FEInterfaceValues<dim> &interface_values) const
+  {
+    // int |[phi]| over the faces of `cell` that are not boundary or periodic
+    // faces; a face between two cells that both touch solid is seen from
+    // both, so each side takes half of it
+    const FEValuesExtractors::Scalar     phi(0);
+    std::vector<double>                  inside, outside;
+    std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
+    const auto touches = [&](const auto &other) {
+      other->get_dof_indices(dofs);
+      for (unsigned int j = 0; j < fe.base_element(0).n_dofs_per_cell(); ++j)
+        if (solution(dofs[fe.component_to_system_index(0, j)]) > touches_solid)
+          return true;
+      return false;
+    };
+    const auto jump = [&](const auto &other) {
+      const unsigned int n = interface_values.n_quadrature_points;
+      inside.resize(n);
+      outside.resize(n);
+      interface_values.get_fe_face_values(0)[phi].get_function_values(solution, inside);
+      interface_values.get_fe_face_values(1)[phi].get_function_values(solution, outside);
+      double integral = 0.;
+      for (unsigned int q = 0; q < n; ++q)
+        integral += std::abs(inside[q] - outside[q]) * interface_values.JxW(q);
+      return touches(other) ? 0.5 * integral : integral;
+    };
+    const unsigned int invalid = numbers::invalid_unsigned_int;
+    double             total   = 0.;
+    for (const unsigned int f : cell->face_indices())
+      {
+        if (cell->at_boundary(f))
+          continue;
+        if (cell->neighbor_is_coarser(f))
+          {
+            const auto neighbor = cell->neighbor(f);
+            const auto [nf, nsf] = cell->neighbor_of_coarser_neighbor(f);
+            interface_values.reinit(cell, f, invalid, neighbor, nf, nsf);
+            total += jump(neighbor);
+          }
+        else if (cell->neighbor(f)->has_children())
+          for (unsigned int sf = 0; sf < cell->face(f)->n_children(); ++sf)
+            {
+              const auto child = cell->neighbor_child_on_subface(f, sf);
+              interface_values.reinit(cell, f, sf, child, cell->neighbor_of_neighbor(f), invalid);
+              total += jump(child);
+            }
+        else
+          {
+            const auto neighbor = cell->neighbor(f);
+            interface_values.reinit(cell, f, invalid, neighbor, cell->neighbor_of_neighbor(f), invalid);
+            total += jump(neighbor);
+          }
+      }
+    return total;
+  }
+
+  template <int dim>
   SolidDiagnostics SolidPhase<dim>::diagnostics() const
   {
     SolidDiagnostics d;
     const QGauss<dim>  quadrature(fe.degree + 2);
     // phi on every cell through its own scalar element; the system's
     // FEValues (for B) only on cells that hold solid
-    PhiValues<dim>     phi_values(fe, quadrature, update_JxW_values);
+    PhiValues<dim>     phi_values(fe, quadrature, update_JxW_values | update_gradients);
     FEValues<dim>      fe_values(fe, quadrature, update_values | update_quadrature_points);
     const auto        &phi = phi_values.values();
     const unsigned int nc  = fe.n_components();
+    const double       G   = parameters.solid.shear_modulus;
     Point<dim>         worst;
     std::vector<Vector<double>> values(quadrature.size(), Vector<double>(nc));
+    std::vector<Tensor<1, dim>> grad_phi(quadrature.size());
+    FEInterfaceValues<dim> interface_values(fe, QGauss<dim - 1>(fe.degree + 1),
+                                            update_values | update_JxW_values);
+    solution.update_ghost_values();
     double volume = 0., lo = 1e300, hi = -1e300, det_min = 1e300, eig_min = 1e300, eig_max = 1.;
+    double stiffness = 1.;
+    // energy in the tail and in all; interface measure over h; length of
+    // the phi = 1/2 surface
+    double tail_energy = 0., energy = 0., band = 0., surface = 0.;
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
           phi_values.reinit(cell, solution);
+          const auto &scalar = phi_values.fe_values();
           bool solid = false;
-          for (const unsigned int q : phi_values.fe_values().quadrature_point_indices())
+          double cell_lo = 1e300, cell_hi = -1e300, cell_band = 0., variation = 0.;
+          for (const unsigned int q : scalar.quadrature_point_indices())
             {
-              volume += phi[q] * phi_values.fe_values().JxW(q);
+              volume += phi[q] * scalar.JxW(q);
               lo    = std::min(lo, phi[q]);
               hi    = std::max(hi, phi[q]);
               solid = solid || phi[q] >= solid_threshold;
+              if (phi[q] > 0.01 && phi[q] < 0.99)
+                cell_band += scalar.JxW(q);
             }
           // nodal values too: the limiter's bounds hold there as well
           for (const double value : phi_values.dof_values())
             {
-              lo = std::min(lo, value);
-              hi = std::max(hi, value);
+              cell_lo = std::min(cell_lo, value);
+              cell_hi = std::max(cell_hi, value);
+            }
+          lo = std::min(lo, cell_lo);
+          hi = std::max(hi, cell_hi);
+          band += cell_band / cell->diameter() * std::sqrt(double(dim));
+          // the total variation of phi (co-area: the mean size of its level
+          // sets, the surface of a thin interface), inside and across faces
+          if (cell_hi > touches_solid)
+            {
+              phi_values.gradients(grad_phi);
+              for (const unsigned int q : scalar.quadrature_point_indices())
+                variation += grad_phi[q].norm() * scalar.JxW(q);
+              surface += variation + face_variation(cell, interface_values);
             }
           // B means something only where there is solid
-          if (nc == 1 || !solid)
+          if (nc == 1 || !(solid || cell_hi > weight.lower))
             continue;
           fe_values.reinit(cell);
           fe_values.get_function_values(solution, values);
           for (const unsigned int q : fe_values.quadrature_point_indices())
-            if (phi[q] >= solid_threshold)
-              {
-                SymmetricTensor<2, dim> B;
-                for (unsigned int c = 0; c < n_B; ++c)
-                  B[SymmetricTensor<2, dim>::unrolled_to_component_indices(c)] = values[q][1 + c];
-                det_min = std::min(det_min, determinant(B));
-                const double smallest = smallest_eigenvalue(B);
-                // exact in 2D, an upper bound in 3D (the others are >= smallest)
-                eig_max = std::max(eig_max, trace(B) - (dim - 1) * smallest);
-                if (smallest < eig_min || !std::isfinite(smallest))
-                  {
-                    eig_min = smallest;
-                    worst   = fe_values.quadrature_point(q);
-                  }
-              }
+            {
+              SymmetricTensor<2, dim> B;
+              for (unsigned int c = 0; c < n_B; ++c)
+                B[SymmetricTensor<2, dim>::unrolled_to_component_indices(c)] = values[q][1 + c];
+              const double smallest = smallest_eigenvalue(B);
+              // exact in 2D, an upper bound in 3D (the others are >= smallest)
+              const double largest = trace(B) - (dim - 1) * smallest;
+              const double H       = weight(phi[q]);
+              if (H > 0. && smallest > 0.)
+                {
+                  const double e =
+                    0.5 * G * H * (trace(B) - dim - std::log(determinant(B))) * scalar.JxW(q);
+                  energy += e;
+                  if (phi[q] < 0.5)
+                    tail_energy += e;
+                }
+              if (weight.sharp)
+                stiffness = std::max(stiffness, H * largest);
+              if (phi[q] < solid_threshold)
+                continue;
+              det_min = std::min(det_min, determinant(B));
+              eig_max = std::max(eig_max, largest);
+              if (smallest < eig_min || !std::isfinite(smallest))
+                {
+                  eig_min = smallest;
+                  worst   = fe_values.quadrature_point(q);
+                }
+            }
         }
+    solution.zero_out_ghost_values();
     const MPI_Comm comm = dof_handler.get_communicator();
     d.volume       = Utilities::MPI::sum(volume, comm);
     d.volume_drift = initial_volume > 0 ? (d.volume - initial_volume) / initial_volume : 0.;
     d.min_phi      = Utilities::MPI::min(lo, comm);
     d.max_phi      = Utilities::MPI::max(hi, comm);
+    const double sums[3] = {band, surface, 0.};
+    double       total[3];
+    Utilities::MPI::sum(ArrayView<const double>(sums, 3), comm, ArrayView<double>(total, 3));
+    d.interface_width = total[1] > 0. ? total[0] / total[1] : 0.;
     if (nc > 1)
       {
         d.min_det_B = Utilities::MPI::min(det_min, comm);
         const auto m = Utilities::MPI::min_max_avg(eig_min, comm);
         d.min_eigenvalue_B = m.min;
         d.max_eigenvalue_B = Utilities::MPI::max(eig_max, comm);
+        d.wave_stiffness   = weight.sharp ? Utilities::MPI::max(stiffness, comm) : d.max_eigenvalue_B;
+        const double e[2] = {tail_energy, energy};
+        double       e_total[2];
+        Utilities::MPI::sum(ArrayView<const double>(e, 2), comm, ArrayView<double>(e_total, 2));
+        d.tail_energy_share = e_total[1] > 0. ? e_total[0] / e_total[1] : 0.;
         const Point<dim> where = Utilities::MPI::broadcast(comm, worst, m.min_index);
         for (unsigned int c = 0; c < dim; ++c)
           d.worst_B_location[c] = where[c];
@@ -419,13 +531,12 @@ namespace Suspension::Solid
   }
 
   template <int dim>
-  bool SolidPhase<dim>::holds_only_fluid(const Vector<double> &values) const
+  bool SolidPhase<dim>::unstrained(const Vector<double> &values) const
   {
     for (unsigned int i = 0; i < values.size(); ++i)
       {
         const unsigned int c = fe.system_to_component_index(i).first;
-        if (c == 0 ? std::abs(values[i]) >= fluid_threshold :
-                     values[i] != (c <= dim ? 1. : 0.))
+        if (c > 0 && values[i] != (c <= dim ? 1. : 0.))
           return false;
       }
     return true;
@@ -434,30 +545,30 @@ namespace Suspension::Solid
   template <int dim>
   void SolidPhase<dim>::reset_B_in_fluid()
   {
-    // Pure fluid keeps no memory of deformation: in cells without solid
-    // (phi below fluid_threshold at every node) B is set back to I. Otherwise B would
-    // grow without bound in sheared fluid (B_11 = 1 + (shear t)^2) and its
-    // discretization errors, which the stress G phi (B - I) never sees,
-    // would end the run through the SPD check.
+    // Fluid keeps no memory of deformation. Sharp stress weight: B = I at
+    // every node where H(phi) = 0, so that no stress can build up in the
+    // diffuse tail of phi. Weight phi: in cells without solid (phi below
+    // fluid_threshold at every node); B would otherwise grow without bound
+    // in sheared fluid (B_11 = 1 + (shear t)^2) and its discretization
+    // errors would end the run through the SPD check.
     if (fe.n_components() == 1)
       return;
+    const unsigned int n_nodes = fe.base_element(0).n_dofs_per_cell();
     std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
           cell->get_dof_indices(dofs);
-          bool fluid = true;
-          for (unsigned int i = 0; i < dofs.size() && fluid; ++i)
-            if (fe.system_to_component_index(i).first == 0)
-              fluid = std::abs(solution(dofs[i])) < fluid_threshold;
-          if (!fluid)
-            continue;
-          for (unsigned int i = 0; i < dofs.size(); ++i)
-            {
-              const unsigned int c = fe.system_to_component_index(i).first;
-              if (c > 0)
-                solution(dofs[i]) = (c <= dim ? 1. : 0.);
-            }
+          const auto phi_at = [&](const unsigned int node) {
+            return solution(dofs[fe.component_to_system_index(0, node)]);
+          };
+          bool fluid_cell = true;
+          for (unsigned int j = 0; j < n_nodes && fluid_cell; ++j)
+            fluid_cell = std::abs(phi_at(j)) < fluid_threshold;
+          for (unsigned int j = 0; j < n_nodes; ++j)
+            if (weight.sharp ? weight.resets_B(phi_at(j)) : fluid_cell)
+              for (unsigned int c = 1; c <= n_B; ++c)
+                solution(dofs[fe.component_to_system_index(c, j)]) = (c <= dim ? 1. : 0.);
         }
   }
 
@@ -514,7 +625,10 @@ namespace Suspension::Solid
           fe_u[velocities].get_function_values(velocity, u);
           for (const unsigned int q : fe_values.quadrature_point_indices())
             {
-              const double w = phi[q] * fe_values.JxW(q);
+              // the particle is where it would carry stress, H(phi): its
+              // diffuse tail does not enter the moments (with the weight
+              // 'phi', phi itself)
+              const double w = weight(phi[q]) * fe_values.JxW(q);
               const auto  &x = fe_values.quadrature_point(q);
               m[0] += w;
               m[1] += (phi[q] >= 0.5 ? fe_values.JxW(q) : 0.);
@@ -594,12 +708,12 @@ namespace Suspension::Solid
   {
     if (!pushes_fluid())
       return;
-    // Most cells hold fluid only: phi ~ 0 and B = I (reset_B_in_fluid), so
-    // G phi (B - I) is exactly zero there and the cell is skipped.
+    // Most cells hold fluid only: B = I at every node (reset_B_in_fluid),
+    // so G H (B - I) is exactly zero there and the cell is skipped.
     const auto solid_cell = Fluid::FluidSpace<dim>::cell_of(cell, dof_handler);
     cell_values.reinit(fe.n_dofs_per_cell());
     solid_cell->get_dof_values(solution, cell_values);
-    if (!body_force && holds_only_fluid(cell_values))
+    if (!body_force && unstrained(cell_values))
       return;
     const auto &values = values_at(solid_cell, unit_points);
     if (body_force)
@@ -616,7 +730,7 @@ namespace Suspension::Solid
       for (unsigned int c = 0; c < n_B; ++c)
         {
           const auto ij = SymmetricTensor<2, dim>::unrolled_to_component_indices(c);
-          stress[q][ij] += G * values[q][0] * (values[q][1 + c] - (ij[0] == ij[1] ? 1. : 0.));
+          stress[q][ij] += G * weight(values[q][0]) * (values[q][1 + c] - (ij[0] == ij[1] ? 1. : 0.));
         }
   }
 
@@ -636,7 +750,7 @@ namespace Suspension::Solid
     const double G      = parameters.solid.shear_modulus;
     for (unsigned int q = 0; q < unit_points.size(); ++q)
       {
-        modulus[q] = G * values[q][0];
+        modulus[q] = G * weight(values[q][0]);
         for (unsigned int c = 0; c < n_B; ++c)
           B[q][SymmetricTensor<2, dim>::unrolled_to_component_indices(c)] = values[q][1 + c];
       }

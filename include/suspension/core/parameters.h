@@ -202,7 +202,7 @@ namespace Suspension::Parameters
   {
     InitialFraction                  initial_fraction = InitialFraction::none;
     std::vector<std::vector<double>> particles; // centre..., radius
-    double                           interface_width = 1.5; // in cells
+    double                           interface_width = 0.; // in cells; 0: exact cell fractions
     std::string                      fraction_expression;
     std::string                      constants;
     double                           shear_modulus = 0.;
@@ -213,6 +213,9 @@ namespace Suspension::Parameters
     /// semi-implicit: the stress increment dt G phi (grad u B + B grad u^T),
     /// linear in the new velocity, goes into the momentum predictor
     bool                             semi_implicit = false;
+    /// stress G H(phi) (B - I): H a smooth step across 1/2 (sharp) or phi
+    bool                             sharp_stress        = true;
+    double                           stress_weight_width = 0.2;
     /// force per unit volume of solid, applied as phi g (x, t)
     FunctionExpression               body_force{"", ""};
 

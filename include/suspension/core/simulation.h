@@ -81,6 +81,8 @@ namespace Suspension
     void   add_contact_statistics();
     void   report_contact() const;
     void   add_mesh_statistics(const MeshLevels &levels, bool adapted, double adapt_time);
+    /// 'Verification/Exact solid at probes': errors of phi and B there
+    void   report_solid_probes();
     void   report_solid();
     double smallest_cell() const;
     void   report_errors(double time, bool steady);

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <suspension/solid/stress_weight.h>
+
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/la_parallel_vector.h>
 
@@ -25,6 +27,7 @@ namespace Suspension::Postprocess
     const DoFHandler<dim>                            &dof_handler;
     const LinearAlgebra::distributed::Vector<double> &solution;
     double                                            shear_modulus;
+    Solid::StressWeight                               weight; // stress G H(phi) (B - I)
   };
 
   /// Mean and standard error over samples (Welford's update, stable

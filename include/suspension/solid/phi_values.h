@@ -27,6 +27,8 @@ namespace Suspension::Solid
 
     /// phi at the points of the last reinit()
     const std::vector<double> &values() const { return phi_at_points; }
+    /// grad phi at the points of the last reinit() (needs update_gradients)
+    void gradients(std::vector<Tensor<1, dim>> &grad) const;
     /// phi's nodal values (the DoFs) of the last reinit()
     const std::vector<double> &dof_values() const { return phi_dofs; }
     /// the scalar FEValues: JxW, quadrature points

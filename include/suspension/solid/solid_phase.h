@@ -4,6 +4,7 @@
 #include <deal.II/distributed/solution_transfer.h>
 #include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_handler.h>
+#include <deal.II/fe/fe_interface_values.h>
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/fe/fe_values.h>
 
@@ -11,6 +12,8 @@
 #include <suspension/fluid/fluid_operators.h>
 #include <suspension/fluid/fluid_space.h>
 #include <suspension/fluid/momentum_source.h>
+#include <suspension/solid/initial_fraction.h>
+#include <suspension/solid/stress_weight.h>
 #include <suspension/solid/transport_operator.h>
 
 #include <array>
@@ -26,8 +29,15 @@ namespace Suspension::Solid
     double       min_phi = 0., max_phi = 0.;
     unsigned int limited_cells = 0, out_of_bound_means = 0, substeps = 0;
     double       min_det_B = 1., min_eigenvalue_B = 1.;
-    double       max_eigenvalue_B = 1.; // sets the elastic wave speed sqrt(G lambda / rho)
+    double       max_eigenvalue_B = 1.; // where phi >= 0.1
+    /// largest H(phi) lambda_max(B): the elastic wave speed is sqrt(G H lambda / rho)
+    double       wave_stiffness   = 1.;
     std::array<double, 3> worst_B_location{}; // where min_eigenvalue_B is
+    /// share of the elastic energy (G/2) H (tr B - dim - ln det B) where phi < 1/2
+    double       tail_energy_share = 0.;
+    /// cells across 0.01 < phi < 0.99: its measure over the length (area)
+    /// of the phi = 1/2 surface and the cell size
+    double       interface_width = 0.;
   };
 
   /// What a cell holds, from the values of phi at its nodes and
@@ -122,6 +132,9 @@ namespace Suspension::Solid
 
     SolidDiagnostics diagnostics() const;
 
+    /// How the initial phi was made (exact cell fractions: cut cells).
+    const InitialFractionReport &initial_fraction_report() const { return initial_report; }
+
     /// Moments of phi (one particle), with the velocity for its centroid.
     ParticleShape<dim> particle_shape(const Fluid::FluidSpace<dim> &space,
                                       const Fluid::VectorType      &velocity) const;
@@ -152,11 +165,17 @@ namespace Suspension::Solid
 
   private:
     void reinit_discretization(const Fluid::FluidSpace<dim> &fluid_space);
+    /// int |[phi]| over the inner faces of `cell` (half where the neighbour
+    /// touches solid too, so that the sum over such cells counts each once)
+    double face_variation(const typename DoFHandler<dim>::active_cell_iterator &cell,
+                          FEInterfaceValues<dim> &interface_values) const;
+    /// cells with phi above this at a node enter the interface measures
+    static constexpr double touches_solid = 1e-3;
     void check_B(const SolidDiagnostics &d, double time) const;
     void reset_B_in_fluid();
-    /// phi below fluid_threshold and B = I at every node of the cell
-    /// (values: the cell's DoF values): no stress.
-    bool holds_only_fluid(const Vector<double> &values) const;
+    /// B = I at every node of the cell (values: the cell's DoF values):
+    /// B - I vanishes in the cell, and with it the stress.
+    bool unstrained(const Vector<double> &values) const;
     /// phi and B at unit_points of solid_cell, from cell_values (the
     /// cell's DoF values, read by the caller)
     const std::vector<Vector<double>> &
@@ -165,11 +184,14 @@ namespace Suspension::Solid
 
     /// B is checked (SPD) where phi is at least this.
     static constexpr double solid_threshold = 0.1;
-    /// B is reset to I in cells where phi is below this at every node.
+    /// Stress weight 'phi': B is reset to I in cells where phi is below
+    /// this at every node.
     static constexpr double fluid_threshold = 1e-4;
     void copy_velocity(const Fluid::VectorType &in, VectorType &out) const;
 
     const Parameters::All &parameters;
+    const StressWeight     weight;
+    InitialFractionReport  initial_report;
     FESystem<dim>          fe;
     DoFHandler<dim>        dof_handler;
     TransportOperator<dim> transport;
