@@ -696,6 +696,19 @@ namespace Suspension::Parameters
                       Patterns::Double(0., 1.),
                       "Range of phi around 1/2 across which the sharp stress "
                       "weight rises from 0 to 1.");
+    prm.declare_entry("B reset fraction", "-1", Patterns::Double(-1., 1.),
+                      "Sharp stress weight: B is reset to I at the nodes where "
+                      "phi is at most this; negative: where H(phi) = 0 (phi <= "
+                      "1/2 - w/2). Between it and the weight's lower end B is "
+                      "transported but carries no stress.");
+    prm.declare_entry("Interface compression", std::to_string(d.interface_compression),
+                      Patterns::Double(0., 2.),
+                      "c of an interface-compression flux c |u| phi (1 - phi) "
+                      "n added to the transport of phi (n = grad phi / |grad "
+                      "phi|, towards the solid), which works against the "
+                      "widening of the diffuse interface by the DG transport "
+                      "(Lax-Friedrichs face flux, bounds kept by the limiter); "
+                      "0: off.");
     prm.declare_entry("Body force", zero_vector(dim), Patterns::Anything(),
                       "Force per unit volume of solid g(x, y[, z], t), one "
                       "expression per component separated by ';', applied as "
@@ -767,6 +780,8 @@ namespace Suspension::Parameters
     semi_implicit       = prm.get("Elastic coupling") == "semi-implicit";
     sharp_stress        = prm.get("Stress weight") == "sharp";
     stress_weight_width = prm.get_double("Stress weight width");
+    interface_compression = prm.get_double("Interface compression");
+    B_reset_fraction      = prm.get_double("B reset fraction");
     body_force          = {prm.get("Body force"), constants};
     const std::string list = prm.get("Particles");
     prm.enter_subsection("Seeding");
@@ -1329,6 +1344,7 @@ namespace Suspension::Parameters
     All all;
     all.parse(prm, dim);
     all.input_file = filename;
+    all.overrides  = overrides;
     return all;
   }
 } // namespace Suspension::Parameters

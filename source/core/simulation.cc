@@ -575,7 +575,8 @@ namespace Suspension
         statistics.add_value("D", shape.taylor_deformation);
         statistics.add_value("theta_deg", shape.inclination);
         statistics.add_value("solid_area", shape.solid_area);
-        columns.insert(columns.end(), {"D", "theta_deg", "solid_area"});
+        statistics.add_value("D_phi", shape.taylor_deformation_phi);
+        columns.insert(columns.end(), {"D", "theta_deg", "solid_area", "D_phi"});
       }
     for (const auto &c : columns)
       {
@@ -700,12 +701,13 @@ namespace Suspension
     if (parameters.solid.elastic())
       pcout << "  B: min det " << std::scientific << std::setprecision(6) << d.min_det_B
             << ", min eigenvalue " << d.min_eigenvalue_B << std::defaultfloat << std::endl;
-    pcout << "  interface: " << std::fixed << std::setprecision(2) << d.interface_width
-          << " cells across 0.01 < phi < 0.99";
+    std::ostringstream interface;
+    interface << "  interface: " << std::fixed << std::setprecision(2) << d.interface_width
+              << " cells across 0.01 < phi < 0.99";
     if (parameters.solid.elastic())
-      pcout << ", elastic energy where phi < 1/2: " << std::scientific << std::setprecision(2)
-            << 100. * d.tail_energy_share << " %";
-    pcout << std::defaultfloat << std::endl;
+      interface << ", elastic energy where phi < 1/2: " << std::scientific << std::setprecision(2)
+                << 100. * d.tail_energy_share << " %";
+    pcout << interface.str() << std::endl;
     if (parameters.solid.particles.size() == 1)
       {
         pcout << "  final: " << describe(solid->particle_shape(space, fluid.velocity()))
@@ -866,16 +868,16 @@ namespace Suspension
     report_seeding();
     if (solid && !resuming && solid->initial_fraction_report().cut_cells > 0)
       {
-        const auto &r = solid->initial_fraction_report();
-        pcout << "  initial phi: cell means = exact volume fractions, "
-              << r.cut_cells << " cut cells";
+        const auto        &r = solid->initial_fraction_report();
+        std::ostringstream line;
+        line << "  initial phi: cell means = exact volume fractions, " << r.cut_cells
+             << " cut cells";
         if (r.exact_volume > 0.)
-          pcout << "; volume " << std::scientific << std::setprecision(10)
-                << solid->diagnostics().volume << ", of the particles " << r.exact_volume
-                << std::setprecision(1) << " (relative difference "
-                << std::abs(solid->diagnostics().volume / r.exact_volume - 1.) << ")"
-                << std::defaultfloat;
-        pcout << std::endl;
+          line << "; volume " << std::scientific << std::setprecision(10)
+               << solid->diagnostics().volume << ", of the particles " << r.exact_volume
+               << std::setprecision(1) << " (relative difference "
+               << std::abs(solid->diagnostics().volume / r.exact_volume - 1.) << ")";
+        pcout << line.str() << std::endl;
       }
 
     std::vector<const Fluid::MomentumSource<dim> *> sources;

@@ -48,7 +48,9 @@ namespace Suspension
       for (const auto &value : v.sweep_values)
         {
           pcout << v.sweep_entry << " = " << value << ":" << std::endl;
-          Parameters::All p = Parameters::read(parameters.input_file, dim, {{v.sweep_entry, value}});
+          auto overrides = parameters.overrides;
+          overrides.emplace_back(v.sweep_entry, value);
+          Parameters::All p = Parameters::read(parameters.input_file, dim, overrides);
           runs.emplace_back(value, run_one<dim>(p, communicator));
         }
       std::unique_ptr<FunctionParser<1>> expected;

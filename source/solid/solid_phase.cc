@@ -117,7 +117,14 @@ namespace Suspension::Solid
     velocity_constraints.close();
     transport.reinit(dof_handler, fluid_space.dof_velocity, velocity_constraints,
                      parameters.solid.elastic());
+    transport.set_compression(parameters.solid.interface_compression);
     transport.initialize_solid_vector(solution);
+    {
+      IndexSet relevant;
+      DoFTools::extract_locally_relevant_dofs(dof_handler, relevant);
+      relevant_solution.reinit(dof_handler.locally_owned_dofs(), relevant,
+                               dof_handler.get_communicator());
+    }
     transport.initialize_solid_vector(stage);
     transport.initialize_solid_vector(stage_rhs);
     transport.initialize_velocity_vector(u0);
@@ -344,7 +351,7 @@ namespace Suspension::Solid
     const auto touches = [&](const auto &other) {
       other->get_dof_indices(dofs);
       for (unsigned int j = 0; j < fe.base_element(0).n_dofs_per_cell(); ++j)
-        if (solution(dofs[fe.component_to_system_index(0, j)]) > touches_solid)
+        if (relevant_solution(dofs[fe.component_to_system_index(0, j)]) > touches_solid)
           return true;
       return false;
     };
@@ -352,8 +359,8 @@ namespace Suspension::Solid
       const unsigned int n = interface_values.n_quadrature_points;
       inside.resize(n);
       outside.resize(n);
-      interface_values.get_fe_face_values(0)[phi].get_function_values(solution, inside);
-      interface_values.get_fe_face_values(1)[phi].get_function_values(solution, outside);
+      interface_values.get_fe_face_values(0)[phi].get_function_values(relevant_solution, inside);
+      interface_values.get_fe_face_values(1)[phi].get_function_values(relevant_solution, outside);
       double integral = 0.;
       for (unsigned int q = 0; q < n; ++q)
         integral += std::abs(inside[q] - outside[q]) * interface_values.JxW(q);
@@ -406,7 +413,8 @@ namespace Suspension::Solid
     std::vector<Tensor<1, dim>> grad_phi(quadrature.size());
     FEInterfaceValues<dim> interface_values(fe, QGauss<dim - 1>(fe.degree + 1),
                                             update_values | update_JxW_values);
-    solution.update_ghost_values();
+    relevant_solution.copy_locally_owned_data_from(solution);
+    relevant_solution.update_ghost_values();
     double volume = 0., lo = 1e300, hi = -1e300, det_min = 1e300, eig_min = 1e300, eig_max = 1.;
     double stiffness = 1.;
     // energy in the tail and in all; interface measure over h; length of
@@ -481,7 +489,6 @@ namespace Suspension::Solid
                 }
             }
         }
-    solution.zero_out_ghost_values();
     const MPI_Comm comm = dof_handler.get_communicator();
     d.volume       = Utilities::MPI::sum(volume, comm);
     d.volume_drift = initial_volume > 0 ? (d.volume - initial_volume) / initial_volume : 0.;
@@ -614,8 +621,10 @@ namespace Suspension::Solid
     const FEValuesExtractors::Vector velocities(0);
     std::vector<double>         phi(quadrature.size());
     std::vector<Tensor<1, dim>> u(quadrature.size());
-    // moments: V, V x, V u, V x x^T (unrolled), area(phi >= 1/2)
-    std::vector<double> m(2 + 2 * dim + dim * dim, 0.);
+    // moments with the weights H(phi) and phi: V, V x, V u, V x x^T
+    // (unrolled); then area(phi >= 1/2)
+    const unsigned int  n_m = 1 + 2 * dim + dim * dim;
+    std::vector<double> m(2 * n_m + 1, 0.);
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
@@ -625,49 +634,61 @@ namespace Suspension::Solid
           fe_u[velocities].get_function_values(velocity, u);
           for (const unsigned int q : fe_values.quadrature_point_indices())
             {
+              const auto &x = fe_values.quadrature_point(q);
+              m[2 * n_m] += (phi[q] >= 0.5 ? fe_values.JxW(q) : 0.);
               // the particle is where it would carry stress, H(phi): its
-              // diffuse tail does not enter the moments (with the weight
-              // 'phi', phi itself)
-              const double w = weight(phi[q]) * fe_values.JxW(q);
-              const auto  &x = fe_values.quadrature_point(q);
-              m[0] += w;
-              m[1] += (phi[q] >= 0.5 ? fe_values.JxW(q) : 0.);
-              for (unsigned int d = 0; d < dim; ++d)
+              // diffuse tail does not enter these moments; the second set
+              // weighs with phi itself
+              const double weights[2] = {weight(phi[q]), phi[q]};
+              for (unsigned int set = 0; set < 2; ++set)
                 {
-                  m[2 + d] += w * x[d];
-                  m[2 + dim + d] += w * u[q][d];
-                  for (unsigned int e = 0; e < dim; ++e)
-                    m[2 + 2 * dim + d * dim + e] += w * x[d] * x[e];
+                  double      *ms = &m[set * n_m];
+                  const double w  = weights[set] * fe_values.JxW(q);
+                  ms[0] += w;
+                  for (unsigned int d = 0; d < dim; ++d)
+                    {
+                      ms[1 + d] += w * x[d];
+                      ms[1 + dim + d] += w * u[q][d];
+                      for (unsigned int e = 0; e < dim; ++e)
+                        ms[1 + 2 * dim + d * dim + e] += w * x[d] * x[e];
+                    }
                 }
             }
         }
     Utilities::MPI::sum(m, dof_handler.get_communicator(), m);
     ParticleShape<dim> s;
-    s.solid_area = m[1];
-    if (m[0] <= 0.)
-      return s;
-    SymmetricTensor<2, dim> moment;
-    for (unsigned int d = 0; d < dim; ++d)
-      {
-        s.centroid[d] = m[2 + d] / m[0];
-        s.velocity[d] = m[2 + dim + d] / m[0];
-      }
-    for (unsigned int d = 0; d < dim; ++d)
-      for (unsigned int e = d; e < dim; ++e)
-        moment[d][e] = m[2 + 2 * dim + d * dim + e] / m[0] - s.centroid[d] * s.centroid[e];
+    s.solid_area = m[2 * n_m];
     // Equivalent ellipse (ellipsoid): second moments a^2/4 (a^2/5) of its
     // semi-axes a.
-    const auto   eig    = eigenvectors(moment);
-    const double factor = dim == 2 ? 4. : 5.;
-    const double L      = std::sqrt(factor * std::max(0., eig.front().first));
-    const double S      = std::sqrt(factor * std::max(0., eig.back().first));
-    s.taylor_deformation = L + S > 0 ? (L - S) / (L + S) : 0.;
-    double angle = std::atan2(eig.front().second[1], eig.front().second[0]) * 180. / numbers::PI;
-    if (angle > 90.)
-      angle -= 180.;
-    if (angle <= -90.)
-      angle += 180.;
-    s.inclination = angle;
+    const auto shape_of = [&](const double *ms, Point<dim> &centroid, Tensor<1, dim> &velocity,
+                              double &deformation, double &inclination) {
+      if (ms[0] <= 0.)
+        return;
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          centroid[d] = ms[1 + d] / ms[0];
+          velocity[d] = ms[1 + dim + d] / ms[0];
+        }
+      SymmetricTensor<2, dim> moment;
+      for (unsigned int d = 0; d < dim; ++d)
+        for (unsigned int e = d; e < dim; ++e)
+          moment[d][e] = ms[1 + 2 * dim + d * dim + e] / ms[0] - centroid[d] * centroid[e];
+      const auto   eig    = eigenvectors(moment);
+      const double factor = dim == 2 ? 4. : 5.;
+      const double L      = std::sqrt(factor * std::max(0., eig.front().first));
+      const double S      = std::sqrt(factor * std::max(0., eig.back().first));
+      deformation         = L + S > 0 ? (L - S) / (L + S) : 0.;
+      double angle = std::atan2(eig.front().second[1], eig.front().second[0]) * 180. / numbers::PI;
+      if (angle > 90.)
+        angle -= 180.;
+      if (angle <= -90.)
+        angle += 180.;
+      inclination = angle;
+    };
+    shape_of(&m[0], s.centroid, s.velocity, s.taylor_deformation, s.inclination);
+    Point<dim>     centroid;
+    Tensor<1, dim> velocity_phi;
+    shape_of(&m[n_m], centroid, velocity_phi, s.taylor_deformation_phi, s.inclination_phi);
     return s;
   }
 

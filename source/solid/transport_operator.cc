@@ -6,6 +6,7 @@
 
 #include <suspension/solid/transport_operator.h>
 
+#include <algorithm>
 #include <functional>
 #include <memory>
 
@@ -58,7 +59,7 @@ namespace Suspension::Solid
     data.mapping_update_flags =
       update_values | update_gradients | update_JxW_values | update_quadrature_points;
     data.mapping_update_flags_inner_faces =
-      update_values | update_JxW_values | update_normal_vectors;
+      update_values | update_gradients | update_JxW_values | update_normal_vectors;
     data.mapping_update_flags_boundary_faces =
       update_values | update_JxW_values | update_normal_vectors;
 
@@ -91,6 +92,24 @@ namespace Suspension::Solid
     using Range = std::pair<unsigned int, unsigned int>;
     using Operation =
       std::function<void(const MatrixFree<dim, double> &, VectorType &, const VectorType &, const Range &)>;
+    const bool compress         = compression > 0.;
+    const auto compression_flux = [this](const VA &phi, const Tensor<1, dim, VA> &grad,
+                                         const Tensor<1, dim, VA> &velocity) {
+      // c |u| phi (1 - phi) grad phi / |grad phi|, zero where phi is flat
+      // or outside (0, 1)
+      Tensor<1, dim, VA> flux;
+      const VA           norm = grad.norm();
+      for (unsigned int v = 0; v < VA::size(); ++v)
+        {
+          const double p = std::clamp(phi[v], 0., 1.);
+          if (norm[v] <= 1e-12 || p <= 0. || p >= 1.)
+            continue;
+          const double scale = compression * velocity.norm()[v] * p * (1. - p) / norm[v];
+          for (unsigned int d = 0; d < dim; ++d)
+            flux[d][v] = scale * grad[d][v];
+        }
+      return flux;
+    };
 
     const Operation cell_op = [&](const MatrixFree<dim, double> &mf, VectorType &out,
                              const VectorType &in, const Range &range) {
@@ -105,9 +124,15 @@ namespace Suspension::Solid
           u.read_dof_values_plain(velocity);
           u.evaluate(EvaluationFlags::values | EvaluationFlags::gradients);
           phi.reinit(cell);
-          phi.gather_evaluate(in, EvaluationFlags::values);
+          phi.gather_evaluate(in, compress ? EvaluationFlags::values | EvaluationFlags::gradients :
+                                             EvaluationFlags::values);
           for (const unsigned int q : phi.quadrature_point_indices())
-            phi.submit_gradient(u.get_value(q) * phi.get_value(q), q);
+            {
+              Tensor<1, dim, VA> flux = u.get_value(q) * phi.get_value(q);
+              if (compress)
+                flux += compression_flux(phi.get_value(q), phi.get_gradient(q), u.get_value(q));
+              phi.submit_gradient(flux, q);
+            }
           phi.integrate_scatter(EvaluationFlags::gradients, out);
           if (!with_B)
             continue;
@@ -151,12 +176,25 @@ namespace Suspension::Solid
           u.evaluate(EvaluationFlags::values);
           phi_m.reinit(face);
           phi_p.reinit(face);
-          phi_m.gather_evaluate(in, EvaluationFlags::values);
-          phi_p.gather_evaluate(in, EvaluationFlags::values);
+          const auto flags = compress ? EvaluationFlags::values | EvaluationFlags::gradients :
+                                        EvaluationFlags::values;
+          phi_m.gather_evaluate(in, flags);
+          phi_p.gather_evaluate(in, flags);
           for (const unsigned int q : phi_m.quadrature_point_indices())
             {
-              const VA un   = u.get_value(q) * phi_m.get_normal_vector(q);
-              const VA flux = upwind(un, phi_m.get_value(q), phi_p.get_value(q));
+              const auto &n    = phi_m.get_normal_vector(q);
+              const VA    un   = u.get_value(q) * n;
+              VA          flux = upwind(un, phi_m.get_value(q), phi_p.get_value(q));
+              if (compress)
+                {
+                  // Lax-Friedrichs: the speed of c |u| phi (1 - phi) is at most c |u|
+                  const VA speed = compression * u.get_value(q).norm();
+                  flux += 0.5 * (compression_flux(phi_m.get_value(q), phi_m.get_gradient(q),
+                                                  u.get_value(q)) +
+                                 compression_flux(phi_p.get_value(q), phi_p.get_gradient(q),
+                                                  u.get_value(q))) * n +
+                          0.5 * speed * (phi_m.get_value(q) - phi_p.get_value(q));
+                }
               phi_m.submit_value(-flux, q);
               phi_p.submit_value(flux, q);
             }
@@ -220,9 +258,9 @@ namespace Suspension::Solid
         }
     };
 
-    matrix_free.loop(cell_op, face_op, boundary_op, dst, src, true,
-                     MatrixFree<dim, double>::DataAccessOnFaces::values,
-                     MatrixFree<dim, double>::DataAccessOnFaces::values);
+    const auto access = compress ? MatrixFree<dim, double>::DataAccessOnFaces::gradients :
+                                   MatrixFree<dim, double>::DataAccessOnFaces::values;
+    matrix_free.loop(cell_op, face_op, boundary_op, dst, src, true, access, access);
 
     // dst <- M^{-1} dst, cell by cell (exact for FE_DGQ on affine cells)
     const Operation inverse_mass = [&](const MatrixFree<dim, double> &mf, VectorType &out,

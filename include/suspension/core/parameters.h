@@ -216,6 +216,8 @@ namespace Suspension::Parameters
     /// stress G H(phi) (B - I): H a smooth step across 1/2 (sharp) or phi
     bool                             sharp_stress        = true;
     double                           stress_weight_width = 0.2;
+    double                           interface_compression = 0.; // c of the compressive flux
+    double                           B_reset_fraction = -1.; // < 0: where H = 0
     /// force per unit volume of solid, applied as phi g (x, t)
     FunctionExpression               body_force{"", ""};
 
@@ -355,6 +357,9 @@ namespace Suspension::Parameters
   {
     unsigned int       dimension = 2;
     std::string        input_file;
+    /// the command line's --set entries, applied after the file (a sweep
+    /// re-reads the file with them)
+    std::vector<std::pair<std::string, std::string>> overrides;
     Geometry           geometry;
     Mesh               mesh;
     MeshRefinement     mesh_refinement;

@@ -58,6 +58,8 @@ namespace Suspension::Solid
     double         taylor_deformation = 0.; // (L - S) / (L + S)
     double         inclination        = 0.; // degrees, long axis against x
     double         solid_area         = 0.; // measure of {phi >= 1/2}
+    /// the same from the moments of phi itself (tail included)
+    double         taylor_deformation_phi = 0., inclination_phi = 0.;
   };
 
   /**
@@ -196,6 +198,8 @@ namespace Suspension::Solid
     DoFHandler<dim>        dof_handler;
     TransportOperator<dim> transport;
     VectorType             solution, stage, stage_rhs, u0, u1, u_stage;
+    /// solution with every DoF of the ghost cells, for face jumps
+    mutable VectorType     relevant_solution;
     double                 initial_volume = 0., time = 0.;
     mutable std::unique_ptr<FEValues<dim>> stress_values;
     mutable std::vector<Vector<double>>    point_values; // reused: add() runs on every cell

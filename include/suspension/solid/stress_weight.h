@@ -24,11 +24,13 @@ namespace Suspension::Solid
   {
     bool   sharp = true;
     double lower = 0.4, upper = 0.6;
+    double reset = 0.4; // B = I at nodes with phi at most this
 
     explicit StressWeight(const Parameters::Solid &solid)
       : sharp(solid.sharp_stress)
       , lower(0.5 - 0.5 * solid.stress_weight_width)
       , upper(0.5 + 0.5 * solid.stress_weight_width)
+      , reset(solid.B_reset_fraction >= 0. ? solid.B_reset_fraction : lower)
     {}
 
     double operator()(const double phi) const
@@ -45,6 +47,6 @@ namespace Suspension::Solid
 
     /// True where B is reset to I after a step (the point carries no stress
     /// and keeps no memory of deformation).
-    bool resets_B(const double phi) const { return sharp && phi <= lower; }
+    bool resets_B(const double phi) const { return sharp && phi <= reset; }
   };
 } // namespace Suspension::Solid

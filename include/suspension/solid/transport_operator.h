@@ -89,8 +89,14 @@ namespace Suspension::Solid
 
     const MatrixFree<dim, double> &get_matrix_free() const { return matrix_free; }
 
+    /// Interface compression: phi also moves with the flux
+    /// c |u| phi (1 - phi) grad phi / |grad phi| (towards the solid, only
+    /// where 0 < phi < 1), with a Lax-Friedrichs face flux; 0: off.
+    void set_compression(const double c) { compression = c; }
+
   private:
     MatrixFree<dim, double> matrix_free;
     bool                    with_B = false;
+    double                  compression = 0.;
   };
 } // namespace Suspension::Solid
