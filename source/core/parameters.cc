@@ -1237,12 +1237,72 @@ namespace Suspension::Parameters
                        "(walls at -h and +h, periodic otherwise)");
     if (solid.initial_fraction == InitialFraction::random_particles)
       seed_solid(dim);
+    else
+      check_particles(dim);
+    check_probes(dim);
     resolve_contact_force();
     if (flow_driving.type != FlowDrivingType::none &&
         boundary_conditions.type[0] != BoundaryType::periodic)
       throw InputError("Flow driving/Type",
                        "a mean pressure gradient drives flow in x and needs "
                        "periodic x faces");
+  }
+
+  void All::check_particles(const unsigned int dim) const
+  {
+    // Each particle inside the box; a particle may reach through a periodic
+    // face (its image enters on the other side) but not through a wall.
+    const auto &g = geometry;
+    const auto  name = [](const std::vector<double> &p) {
+      std::ostringstream s;
+      for (unsigned int i = 0; i < p.size(); ++i)
+        s << (i ? ", " : "") << p[i];
+      return s.str();
+    };
+    for (const auto &p : solid.particles)
+      for (unsigned int d = 0; d < dim; ++d)
+        {
+          const bool   periodic = boundary_conditions.type[2 * d] == BoundaryType::periodic;
+          const double r        = periodic ? 0. : p[dim];
+          if (!(p[d] - r >= g.box_lower[d] && p[d] + r <= g.box_upper[d]))
+            throw InputError("Solid/Particles",
+                             "the particle '" + name(p) + "' " +
+                               (periodic ? "is centred outside the box" :
+                                           "does not fit between the walls") +
+                               " in direction " + std::to_string(d + 1) + " [" +
+                               std::to_string(g.box_lower[d]) + ", " +
+                               std::to_string(g.box_upper[d]) + "]");
+        }
+    for (unsigned int i = 0; i < solid.particles.size(); ++i)
+      for (unsigned int j = i + 1; j < solid.particles.size(); ++j)
+        {
+          const auto &a = solid.particles[i], &b = solid.particles[j];
+          double      d2 = 0.;
+          for (unsigned int d = 0; d < dim; ++d)
+            {
+              double dx = a[d] - b[d];
+              if (boundary_conditions.type[2 * d] == BoundaryType::periodic)
+                {
+                  const double period = g.box_upper[d] - g.box_lower[d];
+                  dx -= period * std::round(dx / period);
+                }
+              d2 += dx * dx;
+            }
+          if (std::sqrt(d2) < a[dim] + b[dim])
+            throw InputError("Solid/Particles",
+                             "the particles '" + name(a) + "' and '" + name(b) + "' overlap");
+        }
+  }
+
+  void All::check_probes(const unsigned int dim) const
+  {
+    for (const auto &p : output.probe_points)
+      for (unsigned int d = 0; d < dim; ++d)
+        if (!(p[d] >= geometry.box_lower[d] && p[d] <= geometry.box_upper[d]))
+          throw InputError("Output/Probe points",
+                           "the point with coordinate " + std::to_string(p[d]) +
+                             " in direction " + std::to_string(d + 1) +
+                             " lies outside the box");
   }
 
   void All::resolve_contact_force()
@@ -1322,6 +1382,20 @@ namespace Suspension::Parameters
   All read(const std::string &filename, const unsigned int dim,
            const std::vector<std::pair<std::string, std::string>> &overrides)
   {
+    {
+      // an empty scene would silently run every default
+      std::ifstream in(filename);
+      std::string   line;
+      bool          sets_something = false;
+      while (!sets_something && std::getline(in, line))
+        {
+          const auto start = line.find_first_not_of(" \t\r");
+          sets_something   = start != std::string::npos && line[start] != '#';
+        }
+      if (!sets_something)
+        throw std::runtime_error("the file sets no entry (an empty scene would run every "
+                                 "default); 'suspension --print-parameters' lists them");
+    }
     ParameterHandler prm;
     All::declare(prm, dim);
     prm.parse_input(filename);

@@ -143,6 +143,21 @@ namespace Suspension
   }
 
   template <int dim>
+  std::vector<std::map<types::boundary_id, const Function<dim> *>>
+  Scene<dim>::velocity_boundary_functions_by_priority() const
+  {
+    const auto &bc = parameters.boundary_conditions;
+    std::vector<std::map<types::boundary_id, const Function<dim> *>> out(1);
+    for (const auto &[id, f] : boundary_velocity)
+      if (bc.type[id] == Parameters::BoundaryType::no_slip || bc.velocity[id].is_zero())
+        out[0][id] = f.get();
+    for (const auto &[id, f] : boundary_velocity)
+      if (out[0].count(id) == 0)
+        out.push_back({{id, f.get()}});
+    return out;
+  }
+
+  template <int dim>
   bool Scene<dim>::has_inhomogeneous_velocity() const
   {
     const auto &bc = parameters.boundary_conditions;

@@ -46,7 +46,9 @@ namespace Suspension::Fluid
         VectorTools::interpolate_boundary_values(dof_velocity, zeros, constraints);
       }
     else
-      VectorTools::interpolate_boundary_values(dof_velocity, functions, constraints);
+      // a DoF already constrained keeps its value: the first group wins
+      for (const auto &group : scene.velocity_boundary_functions_by_priority())
+        VectorTools::interpolate_boundary_values(dof_velocity, group, constraints);
     constraints.close();
   }
 

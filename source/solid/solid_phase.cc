@@ -254,7 +254,9 @@ namespace Suspension::Solid
     const double k   = parameters.solid.degree;
     if (speed_over_h <= 0.)
       return std::numeric_limits<double>::max();
-    return parameters.solid.transport_cfl / ((2. * k + 1.) * speed_over_h / k_u);
+    // the compression flux moves phi at up to c |u| on top of u
+    const double speed = (1. + parameters.solid.interface_compression) * speed_over_h;
+    return parameters.solid.transport_cfl / ((2. * k + 1.) * speed / k_u);
   }
 
   template <int dim>

@@ -37,6 +37,11 @@ expect statistics_box     "$dir/statistics_not_channel.prm" -- "statistics_not_c
 expect no_checkpoint       "$dir/../checkpoint_restart/scene.prm" --resume -- "no checkpoint" "output_files/checkpoint"
 expect bad_option         "$dir/../checkpoint_restart/scene.prm" --resum -- "unknown or incomplete option" "--resum"
 expect no_argument                                     -- "no parameter file"
+expect empty_file         "$dir/empty.prm"             -- "empty.prm" "sets no entry"
+expect particle_outside   "$dir/particle_outside.prm"  -- "particle_outside.prm" "Solid/Particles" "5, 0, 0.1" "outside the box"
+expect particle_too_large "$dir/particle_too_large.prm" -- "particle_too_large.prm" "Solid/Particles" "does not fit between the walls"
+expect particles_overlap  "$dir/particles_overlap.prm" -- "particles_overlap.prm" "Solid/Particles" "overlap"
+expect probe_outside      "$dir/probe_outside.prm"     -- "probe_outside.prm" "Output/Probe points" "outside the box"
 
 echo "$failures failure(s)"
 [ "$failures" -eq 0 ]

@@ -383,6 +383,10 @@ namespace Suspension::Parameters
     /// they do not fit).
     void seed_solid(unsigned int dim);
     /// 'Solid/Contact force': on or off, and its defaults (radius, speed).
+    /// explicit particles inside the box, apart from the walls and each other
+    void check_particles(unsigned int dim) const;
+    /// probe points inside the box
+    void check_probes(unsigned int dim) const;
     void resolve_contact_force();
   };
 

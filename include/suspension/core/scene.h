@@ -46,6 +46,14 @@ namespace Suspension
     std::map<types::boundary_id, const Function<dim> *>
     velocity_boundary_functions() const;
 
+    /// The faces of velocity_boundary_functions() in the order in which
+    /// their values are imposed: walls at rest (no-slip, or a velocity
+    /// expression that is zero) first, so that a node shared by a wall at
+    /// rest and a moving face (the corners of a lid-driven cavity) is at
+    /// rest; among moving faces, by face id.
+    std::vector<std::map<types::boundary_id, const Function<dim> *>>
+    velocity_boundary_functions_by_priority() const;
+
     /// True if some face has a non-zero prescribed velocity.
     bool has_inhomogeneous_velocity() const;
 
