@@ -873,10 +873,12 @@ namespace Suspension
         line << "  initial phi: cell means = exact volume fractions, " << r.cut_cells
              << " cut cells";
         if (r.exact_volume > 0.)
-          line << "; volume " << std::scientific << std::setprecision(10)
-               << solid->diagnostics().volume << ", of the particles " << r.exact_volume
-               << std::setprecision(1) << " (relative difference "
-               << std::abs(solid->diagnostics().volume / r.exact_volume - 1.) << ")";
+          {
+            const double volume = solid->diagnostics().volume;
+            line << "; volume " << std::scientific << std::setprecision(10) << volume
+                 << ", of the particles " << r.exact_volume << std::setprecision(1)
+                 << " (relative difference " << std::abs(volume / r.exact_volume - 1.) << ")";
+          }
         pcout << line.str() << std::endl;
       }
 

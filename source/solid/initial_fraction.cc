@@ -397,8 +397,6 @@ namespace Suspension::Solid
                                                      quadrature_mean;
           if (exact > 0. && exact < 1.)
             ++report.cut_cells;
-          report.largest_mean_error = std::max(report.largest_mean_error,
-                                               std::abs(quadrature_mean - exact));
           // the Lagrange basis sums to one: a constant shift sets the mean
           const double shift = exact - (coefficients * shape_integral);
           for (unsigned int i = 0; i < n; ++i)
@@ -417,7 +415,6 @@ namespace Suspension::Solid
       }
     const MPI_Comm comm      = dof_handler.get_communicator();
     report.cut_cells          = Utilities::MPI::sum(report.cut_cells, comm);
-    report.largest_mean_error = Utilities::MPI::max(report.largest_mean_error, comm);
     return report;
   }
 

@@ -496,9 +496,9 @@ namespace Suspension::Solid
     d.volume_drift = initial_volume > 0 ? (d.volume - initial_volume) / initial_volume : 0.;
     d.min_phi      = Utilities::MPI::min(lo, comm);
     d.max_phi      = Utilities::MPI::max(hi, comm);
-    const double sums[3] = {band, surface, 0.};
-    double       total[3];
-    Utilities::MPI::sum(ArrayView<const double>(sums, 3), comm, ArrayView<double>(total, 3));
+    const double sums[2] = {band, surface};
+    double       total[2];
+    Utilities::MPI::sum(ArrayView<const double>(sums, 2), comm, ArrayView<double>(total, 2));
     d.interface_width = total[1] > 0. ? total[0] / total[1] : 0.;
     if (nc > 1)
       {

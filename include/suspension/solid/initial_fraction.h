@@ -21,7 +21,6 @@ namespace Suspension::Solid
   struct InitialFractionReport
   {
     unsigned int cut_cells = 0; // cells the interface passes through
-    double       largest_mean_error = 0.; // |quadrature mean - exact fraction|, particles only
     double       exact_volume = 0.; // of the particles within the box (particles only)
   };
 
