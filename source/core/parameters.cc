@@ -709,6 +709,29 @@ namespace Suspension::Parameters
                       "widening of the diffuse interface by the DG transport "
                       "(Lax-Friedrichs face flux, bounds kept by the limiter); "
                       "0: off.");
+    prm.declare_entry("Interface relaxation rate", "0", Patterns::Double(0.),
+                      "Sharp stress weight: B - I relaxes towards 0 at the "
+                      "rate R (1 - H(phi)) (1/time), which vanishes in the "
+                      "solid (H = 1): material in the band 0 < H < 1, which "
+                      "carries little stress, does not accumulate strain; 0: "
+                      "off.");
+    prm.declare_entry("Interface thickness", std::to_string(d.interface_thickness),
+                      Patterns::Double(0., 2.),
+                      "With 'Interface compression' c > 0: the diffusion eps c "
+                      "|u| grad phi that balances the compression, eps this "
+                      "many cells, so that phi keeps the profile 1/(1 + "
+                      "exp(-d/eps)) across the interface (d: distance from "
+                      "phi = 1/2).");
+    prm.declare_entry("Interface sharpening", "1", Patterns::Double(1., 4.),
+                      "Sharpness a of the algebraic interface sharpening "
+                      "(Aliabadi & Tezduyar): after every 'Sharpening "
+                      "interval' steps each DG node value of phi is mapped to "
+                      "c^(1-a) phi^a below c and 1 - (1-c)^(1-a) (1-phi)^a "
+                      "above, c (about 1/2) such that the integral of phi is "
+                      "kept. It keeps the diffuse interface from widening "
+                      "under the DG transport; 1: off.");
+    prm.declare_entry("Sharpening interval", "1", Patterns::Integer(1),
+                      "Time steps between two interface sharpenings.");
     prm.declare_entry("Body force", zero_vector(dim), Patterns::Anything(),
                       "Force per unit volume of solid g(x, y[, z], t), one "
                       "expression per component separated by ';', applied as "
@@ -781,7 +804,11 @@ namespace Suspension::Parameters
     sharp_stress        = prm.get("Stress weight") == "sharp";
     stress_weight_width = prm.get_double("Stress weight width");
     interface_compression = prm.get_double("Interface compression");
+    interface_thickness   = prm.get_double("Interface thickness");
+    interface_relaxation  = prm.get_double("Interface relaxation rate");
     B_reset_fraction      = prm.get_double("B reset fraction");
+    interface_sharpening  = prm.get_double("Interface sharpening");
+    sharpening_interval   = prm.get_integer("Sharpening interval");
     body_force          = {prm.get("Body force"), constants};
     const std::string list = prm.get("Particles");
     prm.enter_subsection("Seeding");

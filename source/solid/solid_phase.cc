@@ -117,7 +117,10 @@ namespace Suspension::Solid
     velocity_constraints.close();
     transport.reinit(dof_handler, fluid_space.dof_velocity, velocity_constraints,
                      parameters.solid.elastic());
-    transport.set_compression(parameters.solid.interface_compression);
+    transport.set_compression(parameters.solid.interface_compression,
+                              parameters.solid.interface_thickness);
+    if (parameters.solid.interface_sharpening > 1.)
+      sharpening.reinit(dof_handler);
     transport.initialize_solid_vector(solution);
     {
       IndexSet relevant;
@@ -254,9 +257,14 @@ namespace Suspension::Solid
     const double k   = parameters.solid.degree;
     if (speed_over_h <= 0.)
       return std::numeric_limits<double>::max();
-    // the compression flux moves phi at up to c |u| on top of u
-    const double speed = (1. + parameters.solid.interface_compression) * speed_over_h;
-    return parameters.solid.transport_cfl / ((2. * k + 1.) * speed / k_u);
+    // the compression flux moves phi at up to c |u| on top of u; its
+    // diffusion eps h c |u| adds the explicit diffusion limit (interior
+    // penalty 2 (k+1)^2 / h, in each direction)
+    const double c     = parameters.solid.interface_compression;
+    const double speed = ((2. * k + 1.) * (1. + c) +
+                          2. * dim * 2. * (k + 1.) * (k + 1.) * parameters.solid.interface_thickness * c) *
+                         speed_over_h / k_u;
+    return parameters.solid.transport_cfl / speed;
   }
 
   template <int dim>
@@ -330,7 +338,8 @@ namespace Suspension::Solid
         limit(solution);
       }
     time += dt;
-    reset_B_in_fluid();
+    sharpen_interface();
+    reset_B_in_fluid(dt);
 
     SolidDiagnostics d     = diagnostics();
     d.limited_cells        = Utilities::MPI::sum(report.limited_cells, dof_handler.get_communicator());
@@ -552,8 +561,24 @@ namespace Suspension::Solid
   }
 
   template <int dim>
-  void SolidPhase<dim>::reset_B_in_fluid()
+  void SolidPhase<dim>::sharpen_interface()
   {
+    if (parameters.solid.interface_sharpening <= 1. ||
+        ++steps_since_sharpening < parameters.solid.sharpening_interval)
+      return;
+    steps_since_sharpening = 0;
+    solution.zero_out_ghost_values();
+    sharpening.apply(solution, parameters.solid.interface_sharpening);
+    // the nodal map keeps the nodes in [0, 1]; between the nodes of
+    // degree > 1 the limiter does (cell means unchanged)
+    if (parameters.solid.limiter && parameters.solid.degree > 1)
+      transport.limit(solution, true);
+  }
+
+  template <int dim>
+  void SolidPhase<dim>::reset_B_in_fluid(const double dt)
+  {
+    const double relaxation = parameters.solid.interface_relaxation;
     // Fluid keeps no memory of deformation. Sharp stress weight: B = I at
     // every node where H(phi) = 0, so that no stress can build up in the
     // diffuse tail of phi. Weight phi: in cells without solid (phi below
@@ -578,6 +603,18 @@ namespace Suspension::Solid
             if (weight.sharp ? weight.resets_B(phi_at(j)) : fluid_cell)
               for (unsigned int c = 1; c <= n_B; ++c)
                 solution(dofs[fe.component_to_system_index(c, j)]) = (c <= dim ? 1. : 0.);
+            else if (relaxation > 0.)
+              {
+                // B - I relaxed at the rate R (1 - H(phi)): zero in the solid
+                const double factor = std::exp(-relaxation * (1. - weight(phi_at(j))) * dt);
+                if (factor < 1.)
+                  for (unsigned int c = 1; c <= n_B; ++c)
+                    {
+                      double &b = solution(dofs[fe.component_to_system_index(c, j)]);
+                      const double identity = (c <= dim ? 1. : 0.);
+                      b = identity + factor * (b - identity);
+                    }
+              }
         }
   }
 

@@ -70,6 +70,19 @@ namespace Suspension::Solid
     // quadrature 0: integrals; 1: k+1 Gauss points for the inverse mass
     const std::vector<Quadrature<1>> quadratures = {QGauss<1>(n_q), QGauss<1>(k + 1)};
     matrix_free.reinit(MappingQ1<dim>(), dofs, constraints, quadratures, data);
+
+    // cell sizes for the interface diffusion: a cell's smallest vertex
+    // distance, a face's the smaller of its two cells'
+    cell_size.resize(matrix_free.n_cell_batches());
+    for (unsigned int cell = 0; cell < cell_size.size(); ++cell)
+      for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+        cell_size[cell][v] = matrix_free.get_cell_iterator(cell, v)->minimum_vertex_distance();
+    face_size.resize(matrix_free.n_inner_face_batches());
+    for (unsigned int face = 0; face < face_size.size(); ++face)
+      for (unsigned int v = 0; v < matrix_free.n_active_entries_per_face_batch(face); ++v)
+        face_size[face][v] =
+          std::min(matrix_free.get_face_iterator(face, v, true).first->minimum_vertex_distance(),
+                   matrix_free.get_face_iterator(face, v, false).first->minimum_vertex_distance());
   }
 
   template <int dim>
@@ -93,6 +106,8 @@ namespace Suspension::Solid
     using Operation =
       std::function<void(const MatrixFree<dim, double> &, VectorType &, const VectorType &, const Range &)>;
     const bool compress         = compression > 0.;
+    const double k              = matrix_free.get_dof_handler(0).get_fe().degree;
+    constexpr double penalty    = 2.;
     const auto compression_flux = [this](const VA &phi, const Tensor<1, dim, VA> &grad,
                                          const Tensor<1, dim, VA> &velocity) {
       // c |u| phi (1 - phi) grad phi / |grad phi|, zero where phi is flat
@@ -130,7 +145,9 @@ namespace Suspension::Solid
             {
               Tensor<1, dim, VA> flux = u.get_value(q) * phi.get_value(q);
               if (compress)
-                flux += compression_flux(phi.get_value(q), phi.get_gradient(q), u.get_value(q));
+                flux += compression_flux(phi.get_value(q), phi.get_gradient(q), u.get_value(q)) -
+                        (thickness * compression * cell_size[cell] * u.get_value(q).norm()) *
+                          phi.get_gradient(q);
               phi.submit_gradient(flux, q);
             }
           phi.integrate_scatter(EvaluationFlags::gradients, out);
@@ -194,6 +211,13 @@ namespace Suspension::Solid
                                  compression_flux(phi_p.get_value(q), phi_p.get_gradient(q),
                                                   u.get_value(q))) * n +
                           0.5 * speed * (phi_m.get_value(q) - phi_p.get_value(q));
+                  // the diffusion eps c |u| grad phi that holds the profile
+                  // at a width eps against the compression (incomplete
+                  // interior penalty)
+                  const VA kappa = thickness * compression * face_size[face] * u.get_value(q).norm();
+                  const VA sigma = penalty * (k + 1.) * (k + 1.) / face_size[face];
+                  flux += kappa * (-0.5 * (phi_m.get_gradient(q) + phi_p.get_gradient(q)) * n +
+                                   sigma * (phi_m.get_value(q) - phi_p.get_value(q)));
                 }
               phi_m.submit_value(-flux, q);
               phi_p.submit_value(flux, q);

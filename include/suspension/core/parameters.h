@@ -217,7 +217,12 @@ namespace Suspension::Parameters
     bool                             sharp_stress        = true;
     double                           stress_weight_width = 0.2;
     double                           interface_compression = 0.; // c of the compressive flux
+    double                           interface_thickness   = 0.25; // eps / h of its diffusion
     double                           B_reset_fraction = -1.; // < 0: where H = 0
+    double                           interface_relaxation = 0.; // R of B - I at rate R (1 - H)
+    /// algebraic sharpening of phi after every `sharpening_interval` steps
+    double                           interface_sharpening = 1.; // a; 1: off
+    unsigned int                     sharpening_interval  = 1;
     /// force per unit volume of solid, applied as phi g (x, t)
     FunctionExpression               body_force{"", ""};
 

@@ -13,6 +13,7 @@
 #include <suspension/fluid/fluid_space.h>
 #include <suspension/fluid/momentum_source.h>
 #include <suspension/solid/initial_fraction.h>
+#include <suspension/solid/interface_sharpening.h>
 #include <suspension/solid/stress_weight.h>
 #include <suspension/solid/transport_operator.h>
 
@@ -174,7 +175,11 @@ namespace Suspension::Solid
     /// cells with phi above this at a node enter the interface measures
     static constexpr double touches_solid = 1e-3;
     void check_B(const SolidDiagnostics &d, double time) const;
-    void reset_B_in_fluid();
+    /// and, with 'Interface relaxation rate' R, B - I relaxed at the rate
+    /// R (1 - H(phi)) over the step dt
+    void reset_B_in_fluid(double dt);
+    /// 'Interface sharpening' after every 'Sharpening interval' steps
+    void sharpen_interface();
     /// B = I at every node of the cell (values: the cell's DoF values):
     /// B - I vanishes in the cell, and with it the stress.
     bool unstrained(const Vector<double> &values) const;
@@ -197,6 +202,8 @@ namespace Suspension::Solid
     FESystem<dim>          fe;
     DoFHandler<dim>        dof_handler;
     TransportOperator<dim> transport;
+    InterfaceSharpening<dim> sharpening;
+    unsigned int           steps_since_sharpening = 0;
     VectorType             solution, stage, stage_rhs, u0, u1, u_stage;
     /// solution with every DoF of the ghost cells, for face jumps
     mutable VectorType     relevant_solution;

@@ -92,11 +92,20 @@ namespace Suspension::Solid
     /// Interface compression: phi also moves with the flux
     /// c |u| phi (1 - phi) grad phi / |grad phi| (towards the solid, only
     /// where 0 < phi < 1), with a Lax-Friedrichs face flux; 0: off.
-    void set_compression(const double c) { compression = c; }
+    /// With it a diffusion eps c |u| grad phi, eps = thickness times the
+    /// cell size, so that the profile settles at phi = 1/(1 + exp(-d/eps))
+    /// (d the distance from the phi = 1/2 surface; Olsson & Kreiss 2005)
+    /// instead of steepening into a step that snaps to the cells.
+    void set_compression(const double c, const double thickness_)
+    {
+      compression = c;
+      thickness   = thickness_;
+    }
 
   private:
     MatrixFree<dim, double> matrix_free;
     bool                    with_B = false;
-    double                  compression = 0.;
+    double                  compression = 0., thickness = 0.;
+    std::vector<VectorizedArray<double>> cell_size, face_size;
   };
 } // namespace Suspension::Solid
