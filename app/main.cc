@@ -7,6 +7,7 @@
 #include <suspension/core/parameters.h>
 #include <suspension/core/study.h>
 
+#include <filesystem>
 #include <fstream>
 #include <iostream>
 #include <regex>
@@ -78,7 +79,9 @@ int main(int argc, char *argv[])
     if (args[i] == "--resume")
       resume = true;
     else if (args[i] == "--set" && i + 1 < args.size() &&
-             args[i + 1].find('=') != std::string::npos)
+             args[i + 1].find('=') == std::string::npos)
+      return fail("--set '" + args[i + 1] + "': expected --set 'Section/Entry=value'");
+    else if (args[i] == "--set" && i + 1 < args.size())
       {
         const std::string &entry = args[++i];
         overrides.emplace_back(entry.substr(0, entry.find('=')), entry.substr(entry.find('=') + 1));
@@ -91,7 +94,14 @@ int main(int argc, char *argv[])
     {
       if (!std::ifstream(filename))
         return fail("cannot read parameter file '" + filename + "'");
-      const unsigned int dim = Parameters::read_dimension(filename);
+      if (std::filesystem::is_directory(filename)) // an ifstream opens it
+        return fail("cannot read parameter file '" + filename + "': it is a directory");
+      unsigned int dim = Parameters::read_dimension(filename);
+      // --set Dimension=3 declares the entries of that dimension (another
+      // value is refused by read())
+      for (const auto &[entry, value] : overrides)
+        if (entry == "Dimension" && (value == "2" || value == "3"))
+          dim = std::stoi(value);
       parameters             = Parameters::read(filename, dim, overrides);
       parameters.checkpoint.resume = resume;
     }
@@ -116,6 +126,10 @@ int main(int argc, char *argv[])
         run_study<2>(parameters, MPI_COMM_WORLD);
       else
         run_study<3>(parameters, MPI_COMM_WORLD);
+    }
+  catch (const Parameters::InputError &e)
+    {
+      return fail("in '" + filename + "': " + e.what()); // found only when run (a directory)
     }
   catch (const dealii::ExceptionBase &e)
     {

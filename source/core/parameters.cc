@@ -976,6 +976,13 @@ namespace Suspension::Parameters
                       "true",
                       Patterns::Bool(),
                       "Print the TimerOutput summary at the end.");
+    prm.declare_entry("Run header",
+                      "true",
+                      Patterns::Bool(),
+                      "Print first the code version and where the parameters "
+                      "as used are recorded (parameters_used.prm, written "
+                      "either way). Tests switch it off: both lines change "
+                      "with the commit and the machine.");
     prm.leave_subsection();
   }
 
@@ -989,6 +996,7 @@ namespace Suspension::Parameters
     interval_time     = prm.get_double("Interval time");
     progress_interval = prm.get_integer("Progress interval");
     timer_summary     = prm.get_bool("Timer summary");
+    run_header        = prm.get_bool("Run header");
     const std::string points = prm.get("Probe points");
     prm.leave_subsection();
     probe_points.clear();
@@ -1242,6 +1250,14 @@ namespace Suspension::Parameters
     verification.parse(prm, dim);
     checkpoint.parse(prm);
 
+    // a channel is bounded by its walls: periodic wall faces would make it
+    // a periodic box that the channel's statistics and contact take for one
+    if (geometry.type == GeometryType::channel &&
+        boundary_conditions.type[2 * (dim - 1)] == BoundaryType::periodic)
+      throw InputError("Boundary conditions/Face " +
+                         BoundaryConditions::face_name(2 * (dim - 1)) + "/Type",
+                       "a channel has walls at -h and +h, they cannot be periodic "
+                       "(a box periodic in every direction: 'Geometry/Type = box')");
     if (geometry.type == GeometryType::channel)
       for (unsigned int d = 0; d + 1 < dim; ++d)
         boundary_conditions.type[2 * d] = boundary_conditions.type[2 * d + 1] =
@@ -1435,6 +1451,17 @@ namespace Suspension::Parameters
           {
             prm.set(parts.back(), value);
           }
+        catch (const ParameterHandler::ExcEntryUndeclared &)
+          {
+            throw InputError(path, "is not an entry (--set 'Section/Entry=value'; "
+                                   "'suspension --print-parameters' lists them)");
+          }
+        catch (const ParameterHandler::ExcValueDoesNotMatchPattern &e)
+          {
+            std::ostringstream why; // names the pattern
+            e.print_info(why);
+            throw InputError(path, "cannot be set to '" + value + "': " + why.str());
+          }
         catch (...)
           {
             throw InputError(path, "cannot be set to '" + value + "'");
@@ -1446,6 +1473,9 @@ namespace Suspension::Parameters
     all.parse(prm, dim);
     all.input_file = filename;
     all.overrides  = overrides;
+    std::ostringstream used;
+    prm.print_parameters(used, ParameterHandler::PRM | ParameterHandler::KeepDeclarationOrder);
+    all.parameters_used = used.str();
     return all;
   }
 } // namespace Suspension::Parameters

@@ -4,6 +4,7 @@
 #include <deal.II/base/mpi.h>
 
 #include <suspension/core/checkpoint.h>
+#include <suspension/core/run_record.h>
 #include <suspension/core/simulation.h>
 #include <suspension/core/study.h>
 
@@ -129,6 +130,15 @@ namespace Suspension
                                "or refinement / time-step cycles");
     if (parameters.checkpoint.resume)
       Checkpoint<dim>(parameters, communicator).find(); // a missing one: one line, nothing run
+    // every swept value read (and checked) before anything is written
+    for (const auto &value : parameters.verification.sweep_values)
+      if (!parameters.verification.sweep_entry.empty())
+        {
+          auto overrides = parameters.overrides;
+          overrides.emplace_back(parameters.verification.sweep_entry, value);
+          Parameters::read(parameters.input_file, dim, overrides);
+        }
+    write_run_record(parameters, communicator); // the first output, after every check
     if (!parameters.verification.sweep_entry.empty())
       return run_sweep<dim>(parameters, communicator);
 

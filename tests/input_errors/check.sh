@@ -23,6 +23,7 @@ expect() {
   done
   [ ! -e should_not_exist ] || { echo "$name: output directory was created"; ok=no; }
   echo "$name: $(cat stderr)"
+  rm -rf should_not_exist # a failed case does not fail the next ones
   [ $ok = yes ] || failures=$((failures + 1))
 }
 
@@ -42,6 +43,32 @@ expect particle_outside   "$dir/particle_outside.prm"  -- "particle_outside.prm"
 expect particle_too_large "$dir/particle_too_large.prm" -- "particle_too_large.prm" "Solid/Particles" "does not fit between the walls"
 expect particles_overlap  "$dir/particles_overlap.prm" -- "particles_overlap.prm" "Solid/Particles" "overlap"
 expect probe_outside      "$dir/probe_outside.prm"     -- "probe_outside.prm" "Output/Probe points" "outside the box"
+
+expect zero_time_step     "$dir/zero_time_step.prm"    -- "zero_time_step.prm" "Time step"
+expect negative_end_time  "$dir/negative_end_time.prm" -- "negative_end_time.prm" "End time"
+expect unknown_geometry   "$dir/unknown_geometry.prm"  -- "unknown_geometry.prm" "Type" "cylinder"
+expect particle_no_radius "$dir/particle_no_radius.prm" -- "particle_no_radius.prm" "Solid/Particles"
+expect subdivisions_count "$dir/subdivisions_count.prm" -- "subdivisions_count.prm" "Subdivisions" "2, 2, 2"
+expect periodic_on_wall   "$dir/periodic_on_wall.prm"  -- "periodic_on_wall.prm" "Face y-/Type"
+expect degree_zero        "$dir/degree_zero.prm"       -- "degree_zero.prm" "Velocity degree"
+expect cfl_out_of_range   "$dir/cfl_out_of_range.prm"  -- "cfl_out_of_range.prm" "CFL number" "0"
+expect statistics_bins_zero "$dir/statistics_bins_zero.prm" -- "statistics_bins_zero.prm" "Number of bins"
+expect checkpoint_interval_negative "$dir/checkpoint_interval_negative.prm" -- "checkpoint_interval_negative.prm" "Interval steps"
+expect negative_radius    "$dir/negative_radius.prm"   -- "negative_radius.prm" "Solid/Particles"
+expect zero_density       "$dir/zero_density.prm"      -- "zero_density.prm" "Density"
+expect box_inverted       "$dir/box_inverted.prm"      -- "box_inverted.prm" "Box upper corner"
+expect probe_one_coordinate "$dir/probe_one_coordinate.prm" -- "probe_one_coordinate.prm" "Output/Probe points"
+expect levels_inverted    "$dir/levels_inverted.prm"   -- "levels_inverted.prm" "level"
+expect sweep_unknown_entry "$dir/sweep_unknown_entry.prm" -- "sweep_unknown_entry.prm" "Viscosityy"
+expect bad_boundary_velocity "$dir/bad_boundary_velocity.prm" -- "bad_boundary_velocity.prm" "Face y+/Velocity"
+touch a_file # a regular file where the output directory should go
+expect output_directory_is_file "$dir/output_directory_is_file.prm" -- "output_directory_is_file.prm" "Output/Directory" "a_file/output"
+rm a_file
+expect set_unknown_entry  "$dir/valid.prm" --set Material/Viscosityy=1 -- "Material/Viscosityy"
+expect set_out_of_range   "$dir/valid.prm" --set Material/Density=-2 -- "Material/Density" "-2"
+expect set_no_value       "$dir/valid.prm" --set Material/Viscosity -- "Material/Viscosity" "Section/Entry=value"
+expect set_dimension      "$dir/valid.prm" --set Dimension=4 -- "Dimension" "4"
+expect directory_as_file  "$dir"                       -- "input_errors" "is a directory"
 
 echo "$failures failure(s)"
 [ "$failures" -eq 0 ]

@@ -287,6 +287,7 @@ namespace Suspension::Parameters
     std::vector<std::vector<double>> probe_points;
     unsigned int                    progress_interval = 10;
     bool                            timer_summary     = true;
+    bool                            run_header        = true;
 
     static void declare(ParameterHandler &prm);
     void        parse(ParameterHandler &prm, unsigned int dim);
@@ -365,6 +366,9 @@ namespace Suspension::Parameters
     /// the command line's --set entries, applied after the file (a sweep
     /// re-reads the file with them)
     std::vector<std::pair<std::string, std::string>> overrides;
+    /// every entry as used (file and overrides), in .prm form: the run
+    /// record (RunRecord) writes it to the output directory
+    std::string        parameters_used;
     Geometry           geometry;
     Mesh               mesh;
     MeshRefinement     mesh_refinement;
