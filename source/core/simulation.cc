@@ -738,7 +738,11 @@ namespace Suspension
           {parameters.verification.exact_fraction, parameters.verification.exact_velocity.constants},
           1);
         phi_l1_error = solid->l1_error(*exact);
+        phi_cell_l1_error = solid->cell_mean_l1_error(parameters.verification.exact_fraction,
+                                                      parameters.verification.exact_velocity.constants);
         pcout << "  phi L1 error " << std::scientific << std::setprecision(4) << phi_l1_error
+              << "; of the cell means against the exact cell fractions " << phi_cell_l1_error
+              << ", over the initial volume " << phi_cell_l1_error / solid->initial_phi_volume()
               << std::defaultfloat << std::endl;
       }
   }
@@ -1099,6 +1103,7 @@ namespace Suspension
     summary.final_errors = last_errors;
     summary.errors       = error_history;
     summary.phi_l1_error = phi_l1_error;
+    summary.phi_cell_l1_error = phi_cell_l1_error;
     if (solid && parameters.solid.particles.size() == 1)
       {
         const auto shape    = solid->particle_shape(space, fluid.velocity());

@@ -190,7 +190,10 @@ namespace Suspension
         };
         table.add_value(key, in_space ? r.smallest_cell : r.time_step);
         if (with_phi)
-          add("phi L1", r.phi_l1_error);
+          {
+            add("phi L1", r.phi_l1_error);
+            add("phi L1 means", r.phi_cell_l1_error);
+          }
         for (unsigned int k = 0; k < r.errors.size() && k < reported.size(); ++k)
           {
             // the last entry is the end of the run (possibly a steady state

@@ -13,11 +13,15 @@ namespace Suspension::Solid
 {
   namespace
   {
-    /// int sqrt(r^2 - x^2) dx
+    /// int sqrt(r^2 - x^2) dx. asin(x / r) would lose half the digits
+    /// where |x| is close to r (a grid line tangent to the disc: 1.7e-9 of
+    /// its area with 5 subdivisions of [-1, 1] and r = 0.2); the angle is
+    /// taken from the chord instead.
     double half_chord_primitive(double x, const double r)
     {
-      x = std::clamp(x, -r, r);
-      return 0.5 * (x * std::sqrt(std::max(0., r * r - x * x)) + r * r * std::asin(x / r));
+      x              = std::clamp(x, -r, r);
+      const double s = std::sqrt(std::max(0., (r - x) * (r + x)));
+      return 0.5 * (x * s + r * r * std::atan2(x, s));
     }
 
     /// int_p^q |{y : |y| <= s(x), y <= Y}| dx with s(x) = sqrt(r^2 - x^2),
@@ -31,7 +35,7 @@ namespace Suspension::Solid
         return 2. * (S(q) - S(p));
       // |x| < a: the chord is cut at Y (length Y + s); |x| > a: the whole
       // chord lies below Y (Y > 0) or above it (Y < 0)
-      const double a     = std::sqrt(r * r - Y * Y);
+      const double a     = std::sqrt(std::max(0., (r - Y) * (r + Y)));
       double       total = 0.;
       const double l = std::max(p, -a), u = std::min(q, a);
       if (u > l)

@@ -11,6 +11,7 @@
 #include <suspension/postprocess/point_values.h>
 #include <suspension/solid/phi_values.h>
 #include <suspension/solid/solid_phase.h>
+#include <suspension/solid/strain_extension.h>
 
 #include <cmath>
 #include <iomanip>
@@ -587,6 +588,14 @@ namespace Suspension::Solid
     // errors would end the run through the SPD check.
     if (fe.n_components() == 1)
       return;
+    if (weight.sharp && parameters.solid.B_extension_rings >= 0)
+      {
+        // B of the solid (H = 1) continued across the band and into the
+        // fluid next to it, I beyond (solid/strain_extension.h)
+        extend_strain_into_fluid(dof_handler, weight.upper, parameters.solid.B_extension_rings,
+                                 solution, relevant_solution);
+        return;
+      }
     const unsigned int n_nodes = fe.base_element(0).n_dofs_per_cell();
     std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
     for (const auto &cell : dof_handler.active_cell_iterators())
@@ -747,6 +756,36 @@ namespace Suspension::Solid
           fe_values[phi_x].get_function_values(solution, phi);
           for (const unsigned int q : fe_values.quadrature_point_indices())
             error += std::abs(phi[q] - exact.value(fe_values.quadrature_point(q))) * fe_values.JxW(q);
+        }
+    return Utilities::MPI::sum(error, dof_handler.get_communicator());
+  }
+
+  template <int dim>
+  double SolidPhase<dim>::cell_mean_l1_error(const std::string &expression,
+                                             const std::string &constants) const
+  {
+    Parameters::All shape                = parameters;
+    shape.solid.initial_fraction         = Parameters::InitialFraction::function;
+    shape.solid.fraction_expression      = expression;
+    shape.solid.constants                = constants;
+    VectorType exact(solution);
+    project_initial_fraction(shape, dof_handler, exact);
+
+    const QGauss<dim> quadrature(fe.degree + 1);
+    FEValues<dim>     fe_values(fe, quadrature, update_values | update_JxW_values);
+    const FEValuesExtractors::Scalar phi_x(0);
+    std::vector<double>              phi(quadrature.size()), fraction(quadrature.size());
+    double                           error = 0.;
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          fe_values.reinit(cell);
+          fe_values[phi_x].get_function_values(solution, phi);
+          fe_values[phi_x].get_function_values(exact, fraction);
+          double difference = 0.;
+          for (const unsigned int q : fe_values.quadrature_point_indices())
+            difference += (phi[q] - fraction[q]) * fe_values.JxW(q);
+          error += std::abs(difference);
         }
     return Utilities::MPI::sum(error, dof_handler.get_communicator());
   }

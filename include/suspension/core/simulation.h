@@ -29,6 +29,7 @@ namespace Suspension
   {
     Postprocess::FlowErrors final_errors;
     double                  phi_l1_error = -1.; // < 0: not computed
+    double                  phi_cell_l1_error = -1.; // of the cell means (VOF papers' measure)
     double                  deformation = 0., inclination = 0.; // one particle
     /// errors at the report times and at the end, in time order
     std::vector<std::pair<double, Postprocess::FlowErrors>> errors;
@@ -111,7 +112,7 @@ namespace Suspension
     double                                    closest_gap_seen = -1., closest_wall_seen = -1.;
     double                                    smallest_contact_cell = 0.;
     unsigned int fewest_particles = std::numeric_limits<unsigned int>::max(), most_particles = 0;
-    double                                    phi_l1_error = -1.;
+    double                                    phi_l1_error = -1., phi_cell_l1_error = -1.;
     Postprocess::FieldOutput<dim>             field_output;
     Postprocess::FlowVerification<dim>        verification;
     std::unique_ptr<Postprocess::ChannelStatistics<dim>> channel_statistics;

@@ -142,8 +142,17 @@ namespace Suspension::Solid
     ParticleShape<dim> particle_shape(const Fluid::FluidSpace<dim> &space,
                                       const Fluid::VectorType      &velocity) const;
 
+    /// Integral of phi at the start of the run.
+    double initial_phi_volume() const { return initial_volume; }
+
     /// L1 norm of phi - exact.
     double l1_error(const Function<dim> &exact) const;
+
+    /// The error measure of VOF papers: the sum over the cells of |mean
+    /// of phi - exact fraction| times the cell's measure, the exact
+    /// fractions of the indicator `expression` computed as for the initial
+    /// phi (adaptive bisection). Zero for the initial phi of that shape.
+    double cell_mean_l1_error(const std::string &expression, const std::string &constants) const;
 
     /// Values of all components at points (phi, then B in unrolled order).
     std::vector<Vector<double>> values_at(const std::vector<Point<dim>> &points) const;
