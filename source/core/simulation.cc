@@ -578,6 +578,12 @@ namespace Suspension
         statistics.add_value("solid_area", shape.solid_area);
         statistics.add_value("D_phi", shape.taylor_deformation_phi);
         columns.insert(columns.end(), {"D", "theta_deg", "solid_area", "D_phi"});
+        if (parameters.solid.elastic())
+          {
+            statistics.add_value("D_B", shape.taylor_deformation_B);
+            statistics.add_value("theta_B_deg", shape.inclination_B);
+            columns.insert(columns.end(), {"D_B", "theta_B_deg"});
+          }
       }
     for (const auto &c : columns)
       {

@@ -14,6 +14,7 @@
 #include <suspension/solid/strain_extension.h>
 
 #include <cmath>
+#include <cstdlib>
 #include <iomanip>
 #include <sstream>
 
@@ -592,8 +593,11 @@ namespace Suspension::Solid
       {
         // B of the solid (H = 1) continued across the band and into the
         // fluid next to it, I beyond (solid/strain_extension.h)
-        extend_strain_into_fluid(dof_handler, weight.upper, parameters.solid.B_extension_rings,
-                                 solution, relevant_solution);
+        // (experiment: 'B extension band' on overwrites the band too)
+        extend_strain_into_fluid(dof_handler, weight.upper,
+                                 std::getenv("SUSPENSION_SLAVE_BAND") ? weight.upper - 1e-12 :
+                                                                        weight.reset,
+                                 parameters.solid.B_extension_rings, solution, relevant_solution);
         return;
       }
     const unsigned int n_nodes = fe.base_element(0).n_dofs_per_cell();
@@ -672,7 +676,12 @@ namespace Suspension::Solid
     // moments with the weights H(phi) and phi: V, V x, V u, V x x^T
     // (unrolled); then area(phi >= 1/2)
     const unsigned int  n_m = 1 + 2 * dim + dim * dim;
-    std::vector<double> m(2 * n_m + 1, 0.);
+    // then the volume of the core (H = 1) and the integral of B over it
+    const bool          elastic = fe.n_components() > 1;
+    const FEValuesExtractors::SymmetricTensor<2> B_x(1);
+    std::vector<SymmetricTensor<2, dim>>        B(quadrature.size());
+    std::vector<double> m(2 * n_m + 1 + 1 + n_B, 0.);
+    double             *core = &m[2 * n_m + 1];
     for (const auto &cell : dof_handler.active_cell_iterators())
       if (cell->is_locally_owned())
         {
@@ -680,10 +689,19 @@ namespace Suspension::Solid
           fe_u.reinit(Fluid::FluidSpace<dim>::cell_of(cell, space.dof_velocity));
           fe_values[phi_x].get_function_values(solution, phi);
           fe_u[velocities].get_function_values(velocity, u);
+          if (elastic)
+            fe_values[B_x].get_function_values(solution, B);
           for (const unsigned int q : fe_values.quadrature_point_indices())
             {
               const auto &x = fe_values.quadrature_point(q);
               m[2 * n_m] += (phi[q] >= 0.5 ? fe_values.JxW(q) : 0.);
+              if (elastic && weight(phi[q]) >= 1.)
+                {
+                  core[0] += fe_values.JxW(q);
+                  for (unsigned int k = 0; k < n_B; ++k)
+                    core[1 + k] += fe_values.JxW(q) *
+                                   B[q].access_raw_entry(k);
+                }
               // the particle is where it would carry stress, H(phi): its
               // diffuse tail does not enter these moments; the second set
               // weighs with phi itself
@@ -737,6 +755,20 @@ namespace Suspension::Solid
     Point<dim>     centroid;
     Tensor<1, dim> velocity_phi;
     shape_of(&m[n_m], centroid, velocity_phi, s.taylor_deformation_phi, s.inclination_phi);
+    if (core[0] > 0.)
+      {
+        // the stretch of the material: a uniformly deformed particle has
+        // semi-axes r sqrt(lambda_i(B)), whatever the shape of phi
+        SymmetricTensor<2, dim> mean_B;
+        for (unsigned int k = 0; k < n_B; ++k)
+          mean_B.access_raw_entry(k) = core[1 + k] / core[0];
+        const auto   eig = eigenvectors(mean_B);
+        const double L = std::sqrt(std::max(0., eig.front().first));
+        const double S = std::sqrt(std::max(0., eig.back().first));
+        s.taylor_deformation_B = (L - S) / (L + S);
+        double angle = std::atan2(eig.front().second[1], eig.front().second[0]) * 180. / numbers::PI;
+        s.inclination_B = angle > 90. ? angle - 180. : (angle <= -90. ? angle + 180. : angle);
+      }
     return s;
   }
 

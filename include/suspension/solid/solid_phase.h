@@ -61,6 +61,9 @@ namespace Suspension::Solid
     double         solid_area         = 0.; // measure of {phi >= 1/2}
     /// the same from the moments of phi itself (tail included)
     double         taylor_deformation_phi = 0., inclination_phi = 0.;
+    /// the stretch of the material, from the mean of B where H(phi) = 1:
+    /// (L - S) / (L + S) with L, S the square roots of its eigenvalues
+    double         taylor_deformation_B = 0., inclination_B = 0.;
   };
 
   /**

@@ -33,6 +33,7 @@ namespace Suspension::Solid
   template <int dim>
   void extend_strain_into_fluid(const DoFHandler<dim> &dof_handler,
                                 double                 solid_level,
+                                double                 fluid_level,
                                 unsigned int           layers,
                                 VectorType            &solution,
                                 VectorType            &relevant);
