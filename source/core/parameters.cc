@@ -709,16 +709,6 @@ namespace Suspension::Parameters
                       "widening of the diffuse interface by the DG transport "
                       "(Lax-Friedrichs face flux, bounds kept by the limiter); "
                       "0: off.");
-    prm.declare_entry("B extension rings", std::to_string(d.B_extension_rings),
-                      Patterns::Integer(-1, 10),
-                      "Sharp stress weight: B is kept only where H(phi) = 1 "
-                      "(phi >= 1/2 + w/2); the other nodes of such a cell take "
-                      "the mean of the kept ones, and this many rings of cells "
-                      "around them the mean B of their neighbours, so that B is "
-                      "continuous across the interface and material that joins "
-                      "the solid brings the solid's deformation, not I; further "
-                      "away B = I. -1: off (B = I wherever H = 0, transported "
-                      "where H > 0).");
     prm.declare_entry("Interface relaxation rate", "0", Patterns::Double(0.),
                       "Sharp stress weight: B - I relaxes towards 0 at the "
                       "rate R (1 - H(phi)) (1/time), which vanishes in the "
@@ -817,7 +807,6 @@ namespace Suspension::Parameters
     interface_thickness   = prm.get_double("Interface thickness");
     interface_relaxation  = prm.get_double("Interface relaxation rate");
     B_reset_fraction      = prm.get_double("B reset fraction");
-    B_extension_rings     = prm.get_integer("B extension rings");
     interface_sharpening  = prm.get_double("Interface sharpening");
     sharpening_interval   = prm.get_integer("Sharpening interval");
     body_force          = {prm.get("Body force"), constants};

@@ -11,10 +11,8 @@
 #include <suspension/postprocess/point_values.h>
 #include <suspension/solid/phi_values.h>
 #include <suspension/solid/solid_phase.h>
-#include <suspension/solid/strain_extension.h>
 
 #include <cmath>
-#include <cstdlib>
 #include <iomanip>
 #include <sstream>
 
@@ -589,17 +587,6 @@ namespace Suspension::Solid
     // errors would end the run through the SPD check.
     if (fe.n_components() == 1)
       return;
-    if (weight.sharp && parameters.solid.B_extension_rings >= 0)
-      {
-        // B of the solid (H = 1) continued across the band and into the
-        // fluid next to it, I beyond (solid/strain_extension.h)
-        // (experiment: 'B extension band' on overwrites the band too)
-        extend_strain_into_fluid(dof_handler, weight.upper,
-                                 std::getenv("SUSPENSION_SLAVE_BAND") ? weight.upper - 1e-12 :
-                                                                        weight.reset,
-                                 parameters.solid.B_extension_rings, solution, relevant_solution);
-        return;
-      }
     const unsigned int n_nodes = fe.base_element(0).n_dofs_per_cell();
     std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
     for (const auto &cell : dof_handler.active_cell_iterators())
@@ -724,6 +711,11 @@ namespace Suspension::Solid
     Utilities::MPI::sum(m, dof_handler.get_communicator(), m);
     ParticleShape<dim> s;
     s.solid_area = m[2 * n_m];
+    // angle of a long axis against x, in (-90, 90] degrees
+    const auto inclination_of = [](const Tensor<1, dim> &axis) {
+      const double angle = std::atan2(axis[1], axis[0]) * 180. / numbers::PI;
+      return angle > 90. ? angle - 180. : (angle <= -90. ? angle + 180. : angle);
+    };
     // Equivalent ellipse (ellipsoid): second moments a^2/4 (a^2/5) of its
     // semi-axes a.
     const auto shape_of = [&](const double *ms, Point<dim> &centroid, Tensor<1, dim> &velocity,
@@ -744,12 +736,7 @@ namespace Suspension::Solid
       const double L      = std::sqrt(factor * std::max(0., eig.front().first));
       const double S      = std::sqrt(factor * std::max(0., eig.back().first));
       deformation         = L + S > 0 ? (L - S) / (L + S) : 0.;
-      double angle = std::atan2(eig.front().second[1], eig.front().second[0]) * 180. / numbers::PI;
-      if (angle > 90.)
-        angle -= 180.;
-      if (angle <= -90.)
-        angle += 180.;
-      inclination = angle;
+      inclination         = inclination_of(eig.front().second);
     };
     shape_of(&m[0], s.centroid, s.velocity, s.taylor_deformation, s.inclination);
     Point<dim>     centroid;
@@ -766,8 +753,7 @@ namespace Suspension::Solid
         const double L = std::sqrt(std::max(0., eig.front().first));
         const double S = std::sqrt(std::max(0., eig.back().first));
         s.taylor_deformation_B = (L - S) / (L + S);
-        double angle = std::atan2(eig.front().second[1], eig.front().second[0]) * 180. / numbers::PI;
-        s.inclination_B = angle > 90. ? angle - 180. : (angle <= -90. ? angle + 180. : angle);
+        s.inclination_B        = inclination_of(eig.front().second);
       }
     return s;
   }

@@ -220,8 +220,6 @@ namespace Suspension::Parameters
     double                           interface_thickness   = 0.25; // eps / h of its diffusion
     double                           B_reset_fraction = -1.; // < 0: where H = 0
     double                           interface_relaxation = 0.; // R of B - I at rate R (1 - H)
-    /// B extended from the solid into this many rings of fluid cells (-1: B = I where H = 0)
-    int                              B_extension_rings = -1;
     /// algebraic sharpening of phi after every `sharpening_interval` steps
     double                           interface_sharpening = 1.; // a; 1: off
     unsigned int                     sharpening_interval  = 1;
