@@ -149,8 +149,10 @@ namespace Suspension::Solid
       initial_report = project_initial_fraction(parameters, dof_handler, solution);
     if (parameters.solid.limiter)
       transport.limit(solution, true);
-    initial_volume = diagnostics().volume;
-    time           = 0.;
+    boundary_outflow = 0.;
+    updates          = 0;
+    initial_volume   = diagnostics().volume;
+    time             = 0.;
   }
 
   template <int dim>
@@ -188,14 +190,15 @@ namespace Suspension::Solid
   template <int dim>
   void SolidPhase<dim>::save(std::ostream &out) const
   {
-    out << "SolidPhase " << std::setprecision(17) << initial_volume << " " << time << "\n";
+    out << "SolidPhase " << std::setprecision(17) << initial_volume << " " << time << " "
+        << boundary_outflow << " " << updates << "\n";
   }
 
   template <int dim>
   void SolidPhase<dim>::load(std::istream &in)
   {
     std::string tag;
-    in >> tag >> initial_volume >> time;
+    in >> tag >> initial_volume >> time >> boundary_outflow >> updates;
     AssertThrow(tag == "SolidPhase" && !in.fail(),
                 ExcMessage("checkpoint: cannot read the solid's state"));
   }
@@ -206,6 +209,7 @@ namespace Suspension::Solid
     reinit_discretization(fluid_space);
     transfer->interpolate(solution);
     transfer.reset();
+    ++updates;
     // The L2 projection onto a coarse cell keeps its mean but may
     // overshoot at nodes: limit as after a transport stage.
     solution.zero_out_ghost_values();
@@ -314,29 +318,42 @@ namespace Suspension::Solid
       report.out_of_bound_means += r.out_of_bound_means;
     };
 
+    // The boundary flux of each stage, with the weight the stage has in
+    // the step: y1 = y0 + h L0, y2 = (3 y0 + y1 + h L1) / 4,
+    // y3 = (y0 + 2 y2 + 2 h L2) / 3 = y0 + h (L0 / 6 + L1 / 6 + 2 L2 / 3).
+    // The limiter keeps cell means, so int phi changes only by these.
+    double outflow = 0., flux = 0.;
     for (unsigned int s = 0; s < n_sub; ++s)
       {
         const double f = s * h / dt;
         // SSP-RK3: stages at t, t + h, t + h/2
         velocity_at(f);
         solution.zero_out_ghost_values();
-        transport.apply(solution, stage_rhs, u_stage);
+        flux = 0.;
+        transport.apply(solution, stage_rhs, u_stage, &flux);
+        outflow += h / 6. * flux;
         stage.equ(1., solution);
         stage.add(h, stage_rhs);
         limit(stage);
 
         velocity_at(f + h / dt);
-        transport.apply(stage, stage_rhs, u_stage);
+        flux = 0.;
+        transport.apply(stage, stage_rhs, u_stage, &flux);
+        outflow += h / 6. * flux;
         stage.add(h, stage_rhs);
         stage.sadd(0.25, 0.75, solution);
         limit(stage);
 
         velocity_at(f + 0.5 * h / dt);
-        transport.apply(stage, stage_rhs, u_stage);
+        flux = 0.;
+        transport.apply(stage, stage_rhs, u_stage, &flux);
+        outflow += 2. * h / 3. * flux;
         stage.add(h, stage_rhs);
         solution.sadd(1. / 3., 2. / 3., stage);
         limit(solution);
       }
+    boundary_outflow += Utilities::MPI::sum(outflow, dof_handler.get_communicator());
+    updates += n_sub;
     time += dt;
     sharpen_interface();
     reset_B_in_fluid(dt);
@@ -503,6 +520,11 @@ namespace Suspension::Solid
     const MPI_Comm comm = dof_handler.get_communicator();
     d.volume       = Utilities::MPI::sum(volume, comm);
     d.volume_drift = initial_volume > 0 ? (d.volume - initial_volume) / initial_volume : 0.;
+    d.initial_volume   = initial_volume;
+    d.boundary_outflow = boundary_outflow;
+    d.updates          = updates;
+    d.mass_balance =
+      initial_volume > 0 ? (d.volume - initial_volume + boundary_outflow) / initial_volume : 0.;
     d.min_phi      = Utilities::MPI::min(lo, comm);
     d.max_phi      = Utilities::MPI::max(hi, comm);
     const double sums[2] = {band, surface};
@@ -569,6 +591,7 @@ namespace Suspension::Solid
     steps_since_sharpening = 0;
     solution.zero_out_ghost_values();
     sharpening.apply(solution, parameters.solid.interface_sharpening);
+    ++updates;
     // the nodal map keeps the nodes in [0, 1]; between the nodes of
     // degree > 1 the limiter does (cell means unchanged)
     if (parameters.solid.limiter && parameters.solid.degree > 1)
