@@ -100,7 +100,8 @@ namespace Suspension::Solid
   template <int dim>
   void TransportOperator<dim>::apply(const VectorType &src,
                                      VectorType       &dst,
-                                     const VectorType &velocity) const
+                                     const VectorType &velocity,
+                                     double           *boundary_flux) const
   {
     using Range = std::pair<unsigned int, unsigned int>;
     using Operation =
@@ -262,12 +263,18 @@ namespace Suspension::Solid
           u.evaluate(EvaluationFlags::values);
           phi.reinit(face);
           phi.gather_evaluate(in, EvaluationFlags::values);
+          VA outflow = 0.;
           for (const unsigned int q : phi.quadrature_point_indices())
             {
-              const VA un = u.get_value(q) * phi.get_normal_vector(q);
-              phi.submit_value(-upwind(un, phi.get_value(q), VA(0.)), q);
+              const VA un   = u.get_value(q) * phi.get_normal_vector(q);
+              const VA flux = upwind(un, phi.get_value(q), VA(0.));
+              phi.submit_value(-flux, q);
+              outflow += flux * phi.JxW(q);
             }
           phi.integrate_scatter(EvaluationFlags::values, out);
+          if (boundary_flux)
+            for (unsigned int v = 0; v < mf.n_active_entries_per_face_batch(face); ++v)
+              *boundary_flux += outflow[v];
           if (!with_B)
             continue;
           auto &b = *b_ptr;

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <limits>
+
 #include <deal.II/base/function.h>
 #include <deal.II/distributed/solution_transfer.h>
 #include <deal.II/distributed/tria.h>
@@ -27,6 +29,16 @@ namespace Suspension::Solid
   struct SolidDiagnostics
   {
     double       volume = 0., volume_drift = 0.; // integral of phi, relative change
+    double       initial_volume = 0.;
+    /// phi that left through the boundary since t = 0 (outflow minus
+    /// inflow, integrated over the steps), and the balance
+    /// (volume - initial volume + boundary_outflow) / initial volume,
+    /// zero up to round-off
+    double       boundary_outflow = 0., mass_balance = 0.;
+    /// what rounds phi since t = 0: transport sub-steps, mesh transfers,
+    /// sharpenings (each rounds every nodal value a bounded number of
+    /// times; the round-off bound of mass_balance is proportional to it)
+    unsigned long long updates = 0;
     double       min_phi = 0., max_phi = 0.;
     unsigned int limited_cells = 0, out_of_bound_means = 0, substeps = 0;
     double       min_det_B = 1., min_eigenvalue_B = 1.;
@@ -40,6 +52,24 @@ namespace Suspension::Solid
     /// of the phi = 1/2 surface and the cell size
     double       interface_width = 0.;
   };
+
+  /**
+   * Round-off bound of |SolidDiagnostics::mass_balance| after `updates`
+   * transport sub-steps, mesh transfers and sharpenings. Each sub-step
+   * rounds every nodal value of phi about 20 times (three RK stages, each
+   * an add and an sadd of vectors, the limiter's shift towards the cell
+   * mean, the rounding of M^{-1} R); a rounding moves the nodal value by at
+   * most u |phi_i|, u = 2^-53, and, the nodal weights int v_i being
+   * positive, int phi by at most u int |phi| <= u int phi(0) (phi >= 0, no
+   * phi flows in). 32 per update leaves room for the residual's own
+   * rounding; one more for the two integrals (compensated sums, a few u).
+   * A worst case: round-to-nearest errors have no sign, and the runs
+   * measured stay within a few u in all (doc/verification.md).
+   */
+  inline double mass_balance_bound(const unsigned long long updates)
+  {
+    return 32. * (updates + 1.) * std::numeric_limits<double>::epsilon() / 2.;
+  }
 
   /// What a cell holds, from the values of phi at its nodes and
   /// quadrature points (see SolidPhase::classify_cells()).
@@ -116,7 +146,8 @@ namespace Suspension::Solid
     /// fields as saved. Call load() too.
     void resume_from_checkpoint(const Fluid::FluidSpace<dim> &fluid_space);
 
-    /// Initial volume and time (text, full precision).
+    /// Initial volume, time, boundary outflow and update count (text, full
+    /// precision).
     void save(std::ostream &out) const;
     void load(std::istream &in);
 
@@ -220,6 +251,10 @@ namespace Suspension::Solid
     /// solution with every DoF of the ghost cells, for face jumps
     mutable VectorType     relevant_solution;
     double                 initial_volume = 0., time = 0.;
+    /// int_0^t int_{boundary} (u.n) phi^ ds dt, summed over the RK stages
+    /// with the weights of the scheme (SolidPhase::advance)
+    double                 boundary_outflow = 0.;
+    unsigned long long     updates = 0; // see SolidDiagnostics::updates
     mutable std::unique_ptr<FEValues<dim>> stress_values;
     mutable std::vector<Vector<double>>    point_values; // reused: add() runs on every cell
     mutable Vector<double>                 cell_values; // of the cell add() works on

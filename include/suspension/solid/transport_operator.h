@@ -73,8 +73,17 @@ namespace Suspension::Solid
     void initialize_solid_vector(VectorType &v) const;
     void initialize_velocity_vector(VectorType &v) const;
 
-    /// dst = M^{-1} R(src; u), u a ghosted velocity vector.
-    void apply(const VectorType &src, VectorType &dst, const VectorType &velocity) const;
+    /// dst = M^{-1} R(src; u), u a ghosted velocity vector. With
+    /// boundary_flux, adds this rank's share of the flux of phi out of the
+    /// domain, int_{boundary} (u.n) phi^ ds (upwind phi^: the inside value
+    /// where u.n > 0, the inflow's phi = 0 where u.n < 0), computed with the
+    /// face quadrature of R itself: d/dt int phi = -(that flux) holds for
+    /// the discrete operator to round-off, since the test functions of a
+    /// cell sum to one.
+    void apply(const VectorType &src,
+               VectorType       &dst,
+               const VectorType &velocity,
+               double           *boundary_flux = nullptr) const;
 
     /// Zhang-Shu scaling of phi towards each cell mean so that 0 <= phi <= 1
     /// at the nodes and quadrature points; means are left unchanged.
