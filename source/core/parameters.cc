@@ -1141,6 +1141,23 @@ namespace Suspension::Parameters
                       "If positive: the last run's D must agree with the "
                       "first run's to this relative difference (e.g. an "
                       "adaptive run against a uniform one).");
+    prm.declare_entry("Sweep deformation measure",
+                      "shape",
+                      Patterns::Selection("shape|material"),
+                      "The Taylor deformation that 'Tolerance' and 'Steady "
+                      "tolerance' judge: shape (the moments of H(phi), the "
+                      "particle's outline) or material (the stretch of the "
+                      "material, (L - S)/(L + S) with L^2, S^2 the eigenvalues "
+                      "of the mean of B where H(phi) = 1; equal to the shape's "
+                      "for a uniformly deformed particle that came from a "
+                      "circle or sphere).");
+    prm.declare_entry("Steady tolerance",
+                      "0",
+                      Patterns::Double(0),
+                      "If positive: the single particle's D (the 'Sweep "
+                      "deformation measure') at the end of each run must "
+                      "differ from its value at the first 'Report times' entry "
+                      "by at most this relative amount.");
     prm.declare_entry("Sweep minimum cell reduction",
                       "0",
                       Patterns::Double(0),
@@ -1185,6 +1202,8 @@ namespace Suspension::Parameters
     sweep_expected_deformation = Utilities::trim(prm.get("Sweep expected deformation"));
     sweep_agreement            = prm.get_double("Sweep agreement");
     sweep_cell_reduction       = prm.get_double("Sweep minimum cell reduction");
+    sweep_material_deformation = prm.get("Sweep deformation measure") == "material";
+    steady_tolerance           = prm.get_double("Steady tolerance");
     time_step_cycles  = prm.get_integer("Time step cycles");
     prm.leave_subsection();
     if (exact_solution == ExactSolutionType::function)

@@ -1040,8 +1040,12 @@ namespace Suspension
               if (solid)
                 report_solid_probes();
               if (solid && parameters.solid.particles.size() == 1)
-                pcout << "  t = " << fluid.time() << ": "
-                      << describe(solid->particle_shape(space, fluid.velocity())) << std::endl;
+                {
+                  const auto shape = solid->particle_shape(space, fluid.velocity());
+                  deformation_history.push_back(
+                    {fluid.time(), shape.taylor_deformation, shape.taylor_deformation_B});
+                  pcout << "  t = " << fluid.time() << ": " << describe(shape) << std::endl;
+                }
             }
         if (output_due(fluid.time(), dt))
           {
@@ -1105,11 +1109,14 @@ namespace Suspension
     summary.errors       = error_history;
     summary.phi_l1_error = phi_l1_error;
     summary.phi_cell_l1_error = phi_cell_l1_error;
+    summary.deformation_history = deformation_history;
     if (solid && parameters.solid.particles.size() == 1)
       {
         const auto shape    = solid->particle_shape(space, fluid.velocity());
         summary.deformation = shape.taylor_deformation;
         summary.inclination = shape.inclination;
+        summary.deformation_B = shape.taylor_deformation_B;
+        summary.inclination_B = shape.inclination_B;
       }
     double h = std::numeric_limits<double>::max();
     for (const auto &cell : triangulation.active_cell_iterators())

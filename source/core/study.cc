@@ -61,7 +61,7 @@ namespace Suspension
           expected->initialize("x", v.sweep_expected_deformation, {});
         }
       pcout << std::endl << "sweep of " << v.sweep_entry << ":" << std::endl;
-      bool   monotonic_D = true, monotonic_theta = true;
+      bool   monotonic_D = true, monotonic_theta = true, steady = true;
       double deviation   = 0.;
       for (unsigned int i = 0; i < runs.size(); ++i)
         {
@@ -69,6 +69,7 @@ namespace Suspension
           pcout << "  " << std::setw(10) << value << "  D = " << std::fixed << std::setprecision(4)
                 << r.deformation << "  inclination = " << std::setprecision(2) << r.inclination
                 << " deg  cells " << r.n_cells;
+          double expected_D = 0.;
           if (expected)
             {
               // a value that is not a number (a switch) makes x = 0
@@ -81,11 +82,40 @@ namespace Suspension
                 {
                 }
               const double e = expected->value(Point<1>(x));
-              deviation      = (r.deformation - e) / e;
+              expected_D     = e;
+              deviation      = ((v.sweep_material_deformation ? r.deformation_B : r.deformation) - e) / e;
               pcout << "  expected D = " << std::setprecision(4) << e << "  deviation "
-                    << std::setprecision(1) << 100. * deviation << " %";
+                    << std::setprecision(1) << 100. * (r.deformation - e) / e << " %";
             }
           pcout << std::defaultfloat << std::endl;
+          if (r.deformation_B > 0.)
+            {
+              // the stretch of the material (mean of B over the core):
+              // its own steady measure, whatever the rest shape of phi
+              pcout << "  " << std::setw(10) << "" << "  D_B = " << std::fixed << std::setprecision(4)
+                    << r.deformation_B << "  inclination_B = " << std::setprecision(2)
+                    << r.inclination_B << " deg";
+              if (expected)
+                pcout << "  deviation " << std::setprecision(1)
+                      << 100. * (r.deformation_B - expected_D) / expected_D << " %";
+              pcout << std::defaultfloat << std::endl;
+            }
+          if (v.steady_tolerance > 0. && !r.deformation_history.empty())
+            {
+              // from the first report time to the end, both measures; the
+              // verdict on the chosen one
+              const auto  &first = r.deformation_history.front();
+              const double change_D   = r.deformation / first[1] - 1.;
+              const double change_D_B = r.deformation_B / first[2] - 1.;
+              const double change     = v.sweep_material_deformation ? change_D_B : change_D;
+              steady = steady && std::abs(change) <= v.steady_tolerance;
+              pcout << "  " << std::setw(10) << "" << "  from t = " << first[0] << " to the end: D "
+                    << std::fixed << std::setprecision(4) << first[1] << " -> " << r.deformation
+                    << " (" << std::showpos << std::setprecision(1) << 100. * change_D
+                    << std::noshowpos << " %), D_B " << std::setprecision(4) << first[2] << " -> "
+                    << r.deformation_B << " (" << std::showpos << std::setprecision(1)
+                    << 100. * change_D_B << std::noshowpos << " %)" << std::defaultfloat << std::endl;
+            }
           if (i > 0)
             {
               monotonic_D     = monotonic_D && r.deformation > runs[i - 1].second.deformation;
@@ -113,8 +143,13 @@ namespace Suspension
                 << (reduction >= v.sweep_cell_reduction ? "yes" : "no") << std::defaultfloat
                 << std::endl;
         }
+      if (v.steady_tolerance > 0.)
+        pcout << "  " << (v.sweep_material_deformation ? "D_B" : "D")
+              << " steady in every run (|change| <= " << v.steady_tolerance
+              << "): " << (steady ? "yes" : "no") << std::endl;
       if (expected && v.tolerance > 0)
-        pcout << "  |deviation| of the last run <= " << std::setprecision(6) << v.tolerance << ": "
+        pcout << "  |deviation" << (v.sweep_material_deformation ? " of D_B" : "")
+              << "| of the last run <= " << std::setprecision(6) << v.tolerance << ": "
               << (std::abs(deviation) <= v.tolerance ? "yes" : "no") << std::endl;
     }
   } // namespace

@@ -265,7 +265,31 @@ namespace Suspension::Solid
       {
         expression      = make_function<dim>({p.solid.fraction_expression, p.solid.constants}, 1);
         shape.value     = [&](const Point<dim> &x) { return expression->value(x); };
-        shape.classify  = [](const BoundingBox<dim> &) { return -1; };
+        // A box is decided (0 or 1) only if the indicator agrees on a
+        // lattice over the box widened by a quarter of its size on each
+        // side, and cut (-1) if it takes both values there: a sliver of the
+        // shape that crosses the box near its boundary, between the Gauss
+        // points, is seen from the lattice or its halo (before: up to 9e-4
+        // of the slotted disc's area was missed). Other values: a smooth
+        // expression (-2), integrated by the Gauss rules.
+        shape.classify = [&](const BoundingBox<dim> &box) {
+          constexpr unsigned int m = dim == 2 ? 8 : 4;
+          const Point<dim>       lower = box.get_boundary_points().first;
+          const Tensor<1, dim>   size  = box.get_boundary_points().second - lower;
+          bool zero = false, one = false, other = false;
+          for (unsigned int k = 0; k < Utilities::fixed_power<dim>(m + 1); ++k)
+            {
+              Point<dim>   x;
+              unsigned int index = k;
+              for (unsigned int d = 0; d < dim; ++d, index /= (m + 1))
+                x[d] = lower[d] + size[d] * (-0.25 + 1.5 * (index % (m + 1)) / m);
+              const double v = expression->value(x);
+              zero           = zero || v == 0.;
+              one            = one || v == 1.;
+              other          = other || (v != 0. && v != 1.);
+            }
+          return other ? -2 : (zero && one ? -1 : (one ? 1 : 0));
+        };
         shape.max_depth = dim == 2 ? 8 : 3;
       }
     else
@@ -359,7 +383,7 @@ namespace Suspension::Solid
                   hi         = std::max(hi, samples[q]);
                 }
               // an indicator changes in this sub-box: bisect
-              const bool cut = k == -1 && (shape.exact_measure || hi - lo > 0.5);
+              const bool cut = k == -1 || (k == -2 && hi - lo > 0.5);
               if (cut && depth < shape.max_depth)
                 {
                   for (unsigned int child = 0; child < GeometryInfo<dim>::max_children_per_cell; ++child)

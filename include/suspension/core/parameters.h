@@ -340,6 +340,11 @@ namespace Suspension::Parameters
     std::string         sweep_expected_deformation; // function of x = value
     double              sweep_agreement      = 0.; // |D_last / D_first - 1|
     double              sweep_cell_reduction = 0.; // cells_first / cells_last
+    /// the D that 'Tolerance' and 'Steady tolerance' judge: the shape's
+    /// (moments of H(phi)) or the material's stretch (mean B of the core)
+    bool                sweep_material_deformation = false;
+    /// |D(end) / D(first report time) - 1| of the single particle at most this (0: off)
+    double              steady_tolerance = 0.;
 
     static void declare(ParameterHandler &prm, unsigned int dim);
     void        parse(ParameterHandler &prm, unsigned int dim);

@@ -1,5 +1,7 @@
 #pragma once
 
+#include <array>
+
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/table_handler.h>
 #include <deal.II/base/timer.h>
@@ -31,6 +33,9 @@ namespace Suspension
     double                  phi_l1_error = -1.; // < 0: not computed
     double                  phi_cell_l1_error = -1.; // of the cell means (VOF papers' measure)
     double                  deformation = 0., inclination = 0.; // one particle
+    double                  deformation_B = 0., inclination_B = 0.; // its material stretch
+    /// (t, D, D_B) of the single particle at the report times
+    std::vector<std::array<double, 3>> deformation_history;
     /// errors at the report times and at the end, in time order
     std::vector<std::pair<double, Postprocess::FlowErrors>> errors;
     double                  smallest_cell = 0.;
@@ -119,6 +124,7 @@ namespace Suspension
     TableHandler                              statistics, probes;
     Postprocess::FlowErrors                   last_errors;
     std::vector<std::pair<double, Postprocess::FlowErrors>> error_history;
+    std::vector<std::array<double, 3>>                        deformation_history;
     std::vector<std::string>                  last_probe_values;
     double                                    smallest_cell_size = 0.; // per mesh
     double                                    last_output_time   = 0.;
