@@ -118,13 +118,19 @@ namespace Suspension
             }
           if (i > 0)
             {
-              monotonic_D     = monotonic_D && r.deformation > runs[i - 1].second.deformation;
-              monotonic_theta = monotonic_theta && r.inclination < runs[i - 1].second.inclination;
+              // on the judged measure: the shape's or the material's
+              const RunSummary &before = runs[i - 1].second;
+              const bool        B      = v.sweep_material_deformation;
+              monotonic_D     = monotonic_D && (B ? r.deformation_B > before.deformation_B :
+                                                    r.deformation > before.deformation);
+              monotonic_theta = monotonic_theta && (B ? r.inclination_B < before.inclination_B :
+                                                        r.inclination < before.inclination);
             }
         }
       // (a sweep of a numerical switch compares runs with each other instead)
       if (runs.size() > 1 && v.sweep_agreement == 0)
-        pcout << "  D grows along the sweep: " << (monotonic_D ? "yes" : "no")
+        pcout << "  " << (v.sweep_material_deformation ? "D_B" : "D")
+              << " grows along the sweep: " << (monotonic_D ? "yes" : "no")
               << ", inclination falls along the sweep: " << (monotonic_theta ? "yes" : "no")
               << std::endl;
       const RunSummary &first = runs.front().second, &last = runs.back().second;
@@ -145,7 +151,8 @@ namespace Suspension
         }
       if (v.steady_tolerance > 0.)
         pcout << "  " << (v.sweep_material_deformation ? "D_B" : "D")
-              << " steady in every run (|change| <= " << v.steady_tolerance
+              << " steady in every run (|change| <= " << std::defaultfloat
+              << std::setprecision(6) << v.steady_tolerance
               << "): " << (steady ? "yes" : "no") << std::endl;
       if (expected && v.tolerance > 0)
         pcout << "  |deviation" << (v.sweep_material_deformation ? " of D_B" : "")
