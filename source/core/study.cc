@@ -100,6 +100,9 @@ namespace Suspension
                       << 100. * (r.deformation_B - expected_D) / expected_D << " %";
               pcout << std::defaultfloat << std::endl;
             }
+          // a run without a report time cannot show that it is steady
+          if (v.steady_tolerance > 0. && r.deformation_history.empty())
+            steady = false;
           if (v.steady_tolerance > 0. && !r.deformation_history.empty())
             {
               // from the first report time to the end, both measures; the
