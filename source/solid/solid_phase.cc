@@ -12,6 +12,7 @@
 #include <suspension/solid/phi_values.h>
 #include <suspension/solid/solid_phase.h>
 
+#include <algorithm>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -717,13 +718,16 @@ namespace Suspension::Solid
           fe_u.reinit(Fluid::FluidSpace<dim>::cell_of(cell, space.dof_velocity));
           fe_values[phi_x].get_function_values(solution, phi);
           fe_u[velocities].get_function_values(velocity, u);
-          if (elastic)
+          // B only where the cell reaches the core (most cells hold fluid)
+          const bool core_cell =
+            elastic && weight(*std::max_element(phi.begin(), phi.end())) >= 1.;
+          if (core_cell)
             fe_values[B_x].get_function_values(solution, B);
           for (const unsigned int q : fe_values.quadrature_point_indices())
             {
               const auto &x = fe_values.quadrature_point(q);
               m[2 * n_m] += (phi[q] >= 0.5 ? fe_values.JxW(q) : 0.);
-              if (elastic && weight(phi[q]) >= 1.)
+              if (core_cell && weight(phi[q]) >= 1.)
                 {
                   core[0] += fe_values.JxW(q);
                   for (unsigned int k = 0; k < n_B; ++k)
