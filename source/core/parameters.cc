@@ -709,6 +709,21 @@ namespace Suspension::Parameters
                       "widening of the diffuse interface by the DG transport "
                       "(Lax-Friedrichs face flux, bounds kept by the limiter); "
                       "0: off.");
+    prm.declare_entry("Interface reconstruction", d.thinc_reconstruction ? "THINC" : "none",
+                      Patterns::Selection("none|THINC"),
+                      "How the transport sees phi in the cells the interface "
+                      "cuts (0 < cell mean < 1). none: the DG polynomial. "
+                      "THINC: the profile 1/2 (1 + tanh(beta (n.xi + d))) in "
+                      "the unit cell xi, n along the cell's mean gradient of "
+                      "phi, d such that its mean is the cell mean, evaluated "
+                      "in the fluxes (upwind face values and cell integrals); "
+                      "the interface stays about a cell wide (doc/method.md, "
+                      "'A sharp interface inside the cell'). Needs "
+                      "axis-parallel cells and Degree >= 1.");
+    prm.declare_entry("THINC sharpness", std::to_string(d.thinc_sharpness),
+                      Patterns::Double(0.1, 20.),
+                      "beta of 'Interface reconstruction = THINC': the profile "
+                      "rises from 0.12 to 0.88 over 1/beta of a cell.");
     prm.declare_entry("Interface relaxation rate", "0", Patterns::Double(0.),
                       "Sharp stress weight: B - I relaxes towards 0 at the "
                       "rate R (1 - H(phi)) (1/time), which vanishes in the "
@@ -805,6 +820,13 @@ namespace Suspension::Parameters
     stress_weight_width = prm.get_double("Stress weight width");
     interface_compression = prm.get_double("Interface compression");
     interface_thickness   = prm.get_double("Interface thickness");
+    thinc_reconstruction  = prm.get("Interface reconstruction") == "THINC";
+    thinc_sharpness       = prm.get_double("THINC sharpness");
+    if (thinc_reconstruction && degree == 0)
+      throw InputError("Solid/Interface reconstruction",
+                       "THINC needs Degree >= 1 (the profiles reach the ghost cells "
+                       "of other ranks through the phi DoFs of a cell); set it to "
+                       "none with Degree = 0");
     interface_relaxation  = prm.get_double("Interface relaxation rate");
     B_reset_fraction      = prm.get_double("B reset fraction");
     interface_sharpening  = prm.get_double("Interface sharpening");

@@ -13,6 +13,7 @@
 #include <suspension/solid/solid_phase.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <cmath>
 #include <iomanip>
 #include <sstream>
@@ -116,6 +117,10 @@ namespace Suspension::Solid
     velocity_constraints.reinit(fluid_space.relevant_velocity);
     DoFTools::make_hanging_node_constraints(fluid_space.dof_velocity, velocity_constraints);
     velocity_constraints.close();
+    // before reinit, which prepares the cell geometry the profiles need
+    transport.set_reconstruction(parameters.solid.thinc_reconstruction ?
+                                   parameters.solid.thinc_sharpness :
+                                   0.);
     transport.reinit(dof_handler, fluid_space.dof_velocity, velocity_constraints,
                      parameters.solid.elastic());
     transport.set_compression(parameters.solid.interface_compression,
@@ -359,6 +364,11 @@ namespace Suspension::Solid
         solution.sadd(1. / 3., 1., stage);
         limit(solution);
       }
+    // the transport sees only the cell means of interface cells (their
+    // THINC profiles); what is measured and weighted sees the polynomial,
+    // so it is made the profile's once per step
+    if (transport.project_to_profiles(solution))
+      limit(solution);
     boundary_outflow += Utilities::MPI::sum(outflow, dof_handler.get_communicator());
     updates += n_sub;
     time += dt;

@@ -1,5 +1,8 @@
+#include <deal.II/base/bounding_box.h>
 #include <deal.II/base/mpi.h>
+#include <deal.II/base/utilities.h>
 #include <deal.II/base/symmetric_tensor.h>
+#include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/mapping_q1.h>
 #include <deal.II/matrix_free/fe_evaluation.h>
 #include <deal.II/matrix_free/operators.h>
@@ -7,6 +10,7 @@
 #include <suspension/solid/transport_operator.h>
 
 #include <algorithm>
+#include <numeric>
 #include <functional>
 #include <memory>
 
@@ -34,6 +38,23 @@ namespace Suspension::Solid
       return b;
     }
 
+    // phi where the transport sees it: the cell's THINC profile at x in
+    // the lanes that have one, the DG value elsewhere
+    template <int dim, typename Lanes>
+    VA seen_phi(const Lanes &profile, const Point<dim, VA> &x, const VA &dg_value)
+    {
+      VA out = dg_value;
+      for (unsigned int v = 0; v < VA::size(); ++v)
+        if (profile[v].active)
+          {
+            double argument = profile[v].offset;
+            for (unsigned int d = 0; d < dim; ++d)
+              argument += profile[v].slope[d] * x[d][v];
+            out[v] = 0.5 * (1. + std::tanh(argument));
+          }
+      return out;
+    }
+
     // upwind flux of a transported quantity: un > 0 takes the inside value
     template <typename T>
     T upwind(const VA &un, const T &inside, const T &outside)
@@ -58,10 +79,11 @@ namespace Suspension::Solid
     data.tasks_parallel_scheme = MatrixFree<dim, double>::AdditionalData::none;
     data.mapping_update_flags =
       update_values | update_gradients | update_JxW_values | update_quadrature_points;
-    data.mapping_update_flags_inner_faces =
-      update_values | update_gradients | update_JxW_values | update_normal_vectors;
+    data.mapping_update_flags_inner_faces = update_values | update_gradients |
+                                            update_JxW_values | update_normal_vectors |
+                                            update_quadrature_points;
     data.mapping_update_flags_boundary_faces =
-      update_values | update_JxW_values | update_normal_vectors;
+      update_values | update_JxW_values | update_normal_vectors | update_quadrature_points;
 
     const AffineConstraints<double> no_constraints;
     const std::vector<const DoFHandler<dim> *>           dofs = {&dof_solid, &dof_velocity};
@@ -83,6 +105,341 @@ namespace Suspension::Solid
         face_size[face][v] =
           std::min(matrix_free.get_face_iterator(face, v, true).first->minimum_vertex_distance(),
                    matrix_free.get_face_iterator(face, v, false).first->minimum_vertex_distance());
+
+    if (thinc_beta > 0.)
+      {
+        // the mean of phi as a functional of its DoFs
+        // (FE_DGQ numbers them lexicographically, as FEEvaluation does)
+        const FiniteElement<dim> &base = dof_solid.get_fe().base_element(0);
+        const QGauss<dim>         exact(k + 2);
+        mean_weights.assign(base.n_dofs_per_cell(), 0.);
+        for (unsigned int i = 0; i < base.n_dofs_per_cell(); ++i)
+          for (unsigned int q = 0; q < exact.size(); ++q)
+            mean_weights[i] += exact.weight(q) * base.shape_value(i, exact.point(q));
+        const QGauss<dim> profile(3);
+        profile_points  = profile.get_points();
+        profile_weights = profile.get_weights();
+
+        // the profile is written in the unit cell of an axis-parallel box
+        const unsigned int n_cells = matrix_free.n_cell_batches() + matrix_free.n_ghost_cell_batches();
+        const unsigned int n_lanes = VectorizedArray<double>::size();
+        cell_corner.assign(n_cells * n_lanes, Point<dim>());
+        cell_volume.assign(n_cells * n_lanes, 0.);
+        cell_vertices.assign(n_cells * n_lanes * GeometryInfo<dim>::vertices_per_cell,
+                             numbers::invalid_unsigned_int);
+        vertex_mean.assign(dof_solid.get_triangulation().n_vertices(), 0.);
+        vertex_weight.assign(dof_solid.get_triangulation().n_vertices(), 0.);
+        cell_extent.assign(n_cells * n_lanes, Tensor<1, dim>());
+        for (unsigned int cell = 0; cell < n_cells; ++cell)
+          for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+            {
+              const auto   it  = matrix_free.get_cell_iterator(cell, v);
+              const auto   box = it->bounding_box();
+              const double product = [&] {
+                double p = 1.;
+                for (unsigned int d = 0; d < dim; ++d)
+                  p *= box.side_length(d);
+                return p;
+              }();
+              if (std::abs(it->measure() - product) > 1e-10 * product)
+                throw std::runtime_error(
+                  "entry 'Solid/Interface reconstruction': THINC needs axis-parallel "
+                  "box cells, and the cell at " +
+                  Utilities::to_string(it->center()[0]) + ", ... is not one");
+              cell_corner[cell * n_lanes + v] = box.get_boundary_points().first;
+              cell_volume[cell * n_lanes + v] = product;
+              for (const unsigned int i : it->vertex_indices())
+                cell_vertices[(cell * n_lanes + v) * GeometryInfo<dim>::vertices_per_cell + i] =
+                  it->vertex_index(i);
+              for (unsigned int d = 0; d < dim; ++d)
+                cell_extent[cell * n_lanes + v][d] = box.side_length(d);
+            }
+        // vertices across periodic faces are one vertex for the averages
+        // (a particle that crosses the channel's periodic ends keeps its
+        // normals): union of the matching vertices of periodic face pairs
+        std::vector<unsigned int> representative(vertex_mean.size());
+        std::iota(representative.begin(), representative.end(), 0u);
+        const auto find = [&](unsigned int v) {
+          while (representative[v] != v)
+            v = representative[v] = representative[representative[v]];
+          return v;
+        };
+        for (const auto &cell : dof_solid.get_triangulation().active_cell_iterators())
+          if (!cell->is_artificial())
+            for (const unsigned int f : cell->face_indices())
+              if (cell->has_periodic_neighbor(f) && !cell->periodic_neighbor_is_coarser(f))
+                {
+                  const auto         other      = cell->periodic_neighbor(f);
+                  const auto         face       = cell->face(f);
+                  const auto         other_face = other->face(cell->periodic_neighbor_face_no(f));
+                  const unsigned int normal     = f / 2;
+                  const double       tolerance  = 1e-8 * cell->minimum_vertex_distance();
+                  for (const unsigned int i : face->vertex_indices())
+                    for (const unsigned int j : other_face->vertex_indices())
+                      {
+                        bool same = true;
+                        for (unsigned int d = 0; d < dim; ++d)
+                          if (d != normal &&
+                              std::abs(face->vertex(i)[d] - other_face->vertex(j)[d]) > tolerance)
+                            same = false;
+                        if (same)
+                          representative[find(face->vertex_index(i))] = find(other_face->vertex_index(j));
+                      }
+                }
+        for (auto &v : cell_vertices)
+          if (v != numbers::invalid_unsigned_int)
+            v = find(v);
+
+        matrix_free.initialize_cell_data_vector(reconstruction);
+        cell_mean.assign(n_cells * n_lanes, 0.);
+        if (matrix_free.n_ghost_cell_batches() > 0)
+          matrix_free.initialize_dof_vector(ghosted, 0);
+
+        // Youngs' normal of an owned cell needs the means of all cells that
+        // share a vertex with it; MatrixFree's ghost cells are only those
+        // across faces, so the ghost layer of the mesh is listed here (its
+        // vertices, volumes and phi DoFs), read from a vector with all
+        // locally relevant DoFs
+        ghost_layer_vertices.clear();
+        ghost_layer_volume.clear();
+        ghost_layer_dofs.clear();
+        std::vector<types::global_dof_index> indices(dof_solid.get_fe().n_dofs_per_cell());
+        for (const auto &cell : dof_solid.active_cell_iterators())
+          if (cell->is_ghost())
+            {
+              for (const unsigned int i : cell->vertex_indices())
+                ghost_layer_vertices.push_back(find(cell->vertex_index(i)));
+              ghost_layer_volume.push_back(cell->measure());
+              cell->get_dof_indices(indices);
+              const std::size_t first = ghost_layer_dofs.size();
+              ghost_layer_dofs.resize(first + base.n_dofs_per_cell());
+              for (unsigned int i = 0; i < indices.size(); ++i)
+                {
+                  const auto [component, index] = dof_solid.get_fe().system_to_component_index(i);
+                  if (component == 0)
+                    ghost_layer_dofs[first + index] = indices[i];
+                }
+            }
+        if (!ghost_layer_volume.empty())
+          {
+            IndexSet relevant;
+            DoFTools::extract_locally_relevant_dofs(dof_solid, relevant);
+            ghost_layer_values.reinit(dof_solid.locally_owned_dofs(), relevant,
+                                      dof_solid.get_communicator());
+          }
+      }
+  }
+
+  template <int dim>
+  typename TransportOperator<dim>::Reconstruction
+  TransportOperator<dim>::reconstruct(const double mean, const Tensor<1, dim> &gradient,
+                                      const Point<dim> &x0, const Tensor<1, dim> &h) const
+  {
+    Reconstruction r;
+    // cells that are (almost) all solid or all fluid, and flat cells (no
+    // normal), keep their polynomial
+    constexpr double tiny = 1e-6;
+    const double     norm = gradient.norm();
+    if (!(mean > tiny && mean < 1. - tiny) || norm < 1e-8)
+      return r;
+    const Tensor<1, dim> n    = gradient / norm;
+    const double         beta = thinc_beta;
+    // the profile's mean is increasing in d: Newton within a bracket where
+    // the profile is below 1e-6 (above 1 - 1e-6) in the whole cell
+    std::array<double, 64> projection; // at most QGauss<3>(4)
+    for (unsigned int q = 0; q < profile_points.size(); ++q)
+      {
+        projection[q] = 0.;
+        for (unsigned int c = 0; c < dim; ++c)
+          projection[q] += n[c] * (profile_points[q][c] - 0.5);
+      }
+    double lo = -1. - 8. / beta, hi = 1. + 8. / beta;
+    // start from the exact offset of a profile normal to a cell face, whose
+    // mean is 1/2 + ln(cosh(beta (d + 1/2)) / cosh(beta (d - 1/2))) / (2 beta)
+    const double q = std::exp(beta * (2. * mean - 1.)), b = std::exp(beta);
+    double       d = std::clamp(std::log((1. - q * b) / (q - b)) / (2. * beta), lo, hi);
+    for (unsigned int iteration = 0; iteration < 60; ++iteration)
+      {
+        double f = -mean, df = 0.;
+        for (unsigned int q = 0; q < profile_points.size(); ++q)
+          {
+            const double t = std::tanh(beta * (projection[q] + d));
+            f += profile_weights[q] * 0.5 * (1. + t);
+            df += profile_weights[q] * 0.5 * beta * (1. - t * t);
+          }
+        if (std::abs(f) < 1e-14)
+          break;
+        (f > 0. ? hi : lo) = d;
+        const double newton = d - f / df;
+        d = (df > 0. && newton > lo && newton < hi) ? newton : 0.5 * (lo + hi);
+        if (hi - lo < 1e-15)
+          break;
+      }
+    // beta (n.(xi - 1/2) + d) with xi = (x - x0) / h, as slope.x + offset
+    r.active = true;
+    r.offset = beta * d;
+    for (unsigned int c = 0; c < dim; ++c)
+      {
+        r.slope[c] = beta * n[c] / h[c];
+        r.offset -= beta * n[c] * (x0[c] / h[c] + 0.5);
+      }
+    return r;
+  }
+
+  template <int dim>
+  void TransportOperator<dim>::compute_reconstruction(const VectorType &src) const
+  {
+    const unsigned int n_lanes  = VectorizedArray<double>::size();
+    const unsigned int n_owned  = matrix_free.n_cell_batches();
+    const unsigned int n_ghosts = matrix_free.n_ghost_cell_batches();
+    const unsigned int n_dofs   = mean_weights.size();
+    const FiniteElement<dim>            &fe = matrix_free.get_dof_handler(0).get_fe();
+    std::vector<types::global_dof_index> indices(fe.n_dofs_per_cell());
+    // the DoF indices of phi in a cell, in the lexicographic order of FE_DGQ
+    std::vector<types::global_dof_index> phi_indices(n_dofs);
+    const auto phi_dofs = [&](const unsigned int cell, const unsigned int v) {
+      matrix_free.get_cell_iterator(cell, v)->get_dof_indices(indices);
+      for (unsigned int i = 0; i < indices.size(); ++i)
+        {
+          const auto [component, index] = fe.system_to_component_index(i);
+          if (component == 0)
+            phi_indices[index] = indices[i];
+        }
+    };
+
+    // 1. cell means
+    std::fill(cell_mean.begin(), cell_mean.end(), 0.);
+    FEEvaluation<dim, -1, 0, 1, double> phi(matrix_free, 0, 0, 0);
+    for (unsigned int cell = 0; cell < n_owned; ++cell)
+      {
+        phi.reinit(cell);
+        phi.read_dof_values_plain(src);
+        for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+          for (unsigned int i = 0; i < n_dofs; ++i)
+            cell_mean[cell * n_lanes + v] += mean_weights[i] * phi.begin_dof_values()[i][v];
+      }
+    // 2. the normal (Youngs): the mean gradient of the multilinear
+    // interpolant of the vertex averages of the cell means, a 3^dim
+    // stencil, as VOF schemes take it from the neighbours. The DG slope of
+    // a cell whose polynomial the profile's fluxes update is no reliable
+    // direction (it turned the profile of a translated band around).
+    constexpr unsigned int n_vertices = GeometryInfo<dim>::vertices_per_cell;
+    std::fill(vertex_mean.begin(), vertex_mean.end(), 0.);
+    std::fill(vertex_weight.begin(), vertex_weight.end(), 0.);
+    for (unsigned int cell = 0; cell < n_owned; ++cell)
+      for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+        {
+          const unsigned int k = cell * n_lanes + v;
+          for (unsigned int i = 0; i < n_vertices; ++i)
+            {
+              vertex_mean[cell_vertices[k * n_vertices + i]] += cell_volume[k] * cell_mean[k];
+              vertex_weight[cell_vertices[k * n_vertices + i]] += cell_volume[k];
+            }
+        }
+    // the ghost layer (all cells that share a vertex with an owned one)
+    if (!ghost_layer_volume.empty())
+      {
+        ghost_layer_values.copy_locally_owned_data_from(src);
+        ghost_layer_values.update_ghost_values();
+        for (std::size_t g = 0; g < ghost_layer_volume.size(); ++g)
+          {
+            double mean = 0.;
+            for (unsigned int i = 0; i < n_dofs; ++i)
+              mean += mean_weights[i] * ghost_layer_values(ghost_layer_dofs[g * n_dofs + i]);
+            for (unsigned int i = 0; i < n_vertices; ++i)
+              {
+                vertex_mean[ghost_layer_vertices[g * n_vertices + i]] += ghost_layer_volume[g] * mean;
+                vertex_weight[ghost_layer_vertices[g * n_vertices + i]] += ghost_layer_volume[g];
+              }
+          }
+        ghost_layer_values.zero_out_ghost_values();
+      }
+
+    // 3. the profiles of the owned cells; the ghost cells receive theirs
+    // through the phi DoFs of a scratch vector
+    for (unsigned int cell = 0; cell < n_owned; ++cell)
+      for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+        {
+          const unsigned int k = cell * n_lanes + v;
+          Tensor<1, dim>     gradient; // its integral over the unit cell
+          for (unsigned int i = 0; i < n_vertices; ++i)
+            {
+              const unsigned int vertex = cell_vertices[k * n_vertices + i];
+              const double       value  = vertex_mean[vertex] / vertex_weight[vertex];
+              for (unsigned int c = 0; c < dim; ++c)
+                gradient[c] += ((i >> c) & 1 ? value : -value) / (n_vertices / 2);
+            }
+          reconstruction[cell][v] = reconstruct(cell_mean[k], gradient, cell_corner[k], cell_extent[k]);
+        }
+    if (n_ghosts == 0)
+      return;
+    ghosted = 0.;
+    for (unsigned int cell = 0; cell < n_owned; ++cell)
+      for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+        if (const auto &r = reconstruction[cell][v]; r.active)
+          {
+            phi_dofs(cell, v);
+            ghosted(phi_indices[0]) = 1.;
+            ghosted(phi_indices[1]) = r.offset;
+            for (unsigned int c = 0; c < dim; ++c)
+              ghosted(phi_indices[2 + c]) = r.slope[c];
+          }
+    ghosted.update_ghost_values();
+    for (unsigned int cell = n_owned; cell < n_owned + n_ghosts; ++cell)
+      for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+        {
+          phi_dofs(cell, v);
+          auto &r  = reconstruction[cell][v];
+          r.active = ghosted(phi_indices[0]) == 1.;
+          r.offset = ghosted(phi_indices[1]);
+          for (unsigned int c = 0; c < dim; ++c)
+            r.slope[c] = ghosted(phi_indices[2 + c]);
+        }
+    ghosted.zero_out_ghost_values();
+  }
+
+  template <int dim>
+  bool TransportOperator<dim>::project_to_profiles(VectorType &solution) const
+  {
+    if (!(thinc_beta > 0.))
+      return false;
+    compute_reconstruction(solution);
+    // the L2 projection of each profile onto Q_k (k + 1 Gauss points per
+    // direction), shifted by a constant so that the cell mean is kept to
+    // round-off (the profile's mean is exact only in its own quadrature)
+    FEEvaluation<dim, -1, 0, 1, double> phi(matrix_free, 0, 1, 0);
+    MatrixFreeOperators::CellwiseInverseMassMatrix<dim, -1, 1, double> inverse(phi);
+    AlignedVector<VA> values(phi.n_q_points);
+    std::vector<VA>   old_dofs(phi.dofs_per_cell);
+    for (unsigned int cell = 0; cell < matrix_free.n_cell_batches(); ++cell)
+      {
+        bool any = false;
+        for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+          any = any || reconstruction[cell][v].active;
+        if (!any)
+          continue;
+        phi.reinit(cell);
+        phi.read_dof_values_plain(solution);
+        for (unsigned int i = 0; i < phi.dofs_per_cell; ++i)
+          old_dofs[i] = phi.begin_dof_values()[i];
+        for (const unsigned int q : phi.quadrature_point_indices())
+          values[q] = seen_phi<dim>(reconstruction[cell], phi.quadrature_point(q), VA(0.));
+        inverse.transform_from_q_points_to_basis(1, values.data(), phi.begin_dof_values());
+        for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+          {
+            double new_mean = 0.;
+            for (unsigned int i = 0; i < phi.dofs_per_cell; ++i)
+              new_mean += mean_weights[i] * phi.begin_dof_values()[i][v];
+            const double shift =
+              cell_mean[cell * VA::size() + v] - new_mean;
+            for (unsigned int i = 0; i < phi.dofs_per_cell; ++i)
+              phi.begin_dof_values()[i][v] = reconstruction[cell][v].active ?
+                                               phi.begin_dof_values()[i][v] + shift :
+                                               old_dofs[i][v];
+          }
+        phi.set_dof_values_plain(solution);
+      }
+    return true;
   }
 
   template <int dim>
@@ -107,6 +464,9 @@ namespace Suspension::Solid
     using Operation =
       std::function<void(const MatrixFree<dim, double> &, VectorType &, const VectorType &, const Range &)>;
     const bool compress         = compression > 0.;
+    const bool thinc            = thinc_beta > 0.;
+    if (thinc)
+      compute_reconstruction(src);
     const double k              = matrix_free.get_dof_handler(0).get_fe().degree;
     constexpr double penalty    = 2.;
     const auto compression_flux = [this](const VA &phi, const Tensor<1, dim, VA> &grad,
@@ -142,9 +502,14 @@ namespace Suspension::Solid
           phi.reinit(cell);
           phi.gather_evaluate(in, compress ? EvaluationFlags::values | EvaluationFlags::gradients :
                                              EvaluationFlags::values);
+          Lanes profile;
+          if (thinc)
+            profile = phi.read_cell_data(reconstruction);
           for (const unsigned int q : phi.quadrature_point_indices())
             {
-              Tensor<1, dim, VA> flux = u.get_value(q) * phi.get_value(q);
+              const VA phi_q = thinc ? seen_phi<dim>(profile, phi.quadrature_point(q), phi.get_value(q)) :
+                                       phi.get_value(q);
+              Tensor<1, dim, VA> flux = u.get_value(q) * phi_q;
               if (compress)
                 flux += compression_flux(phi.get_value(q), phi.get_gradient(q), u.get_value(q)) -
                         (thickness * compression * cell_size[cell] * u.get_value(q).norm()) *
@@ -198,11 +563,20 @@ namespace Suspension::Solid
                                         EvaluationFlags::values;
           phi_m.gather_evaluate(in, flags);
           phi_p.gather_evaluate(in, flags);
+          Lanes profile_m, profile_p;
+          if (thinc)
+            {
+              profile_m = phi_m.read_cell_data(reconstruction);
+              profile_p = phi_p.read_cell_data(reconstruction);
+            }
           for (const unsigned int q : phi_m.quadrature_point_indices())
             {
               const auto &n    = phi_m.get_normal_vector(q);
               const VA    un   = u.get_value(q) * n;
-              VA          flux = upwind(un, phi_m.get_value(q), phi_p.get_value(q));
+              VA          flux = thinc ? upwind(un,
+                                       seen_phi<dim>(profile_m, phi_m.quadrature_point(q), phi_m.get_value(q)),
+                                       seen_phi<dim>(profile_p, phi_m.quadrature_point(q), phi_p.get_value(q))) :
+                                upwind(un, phi_m.get_value(q), phi_p.get_value(q));
               if (compress)
                 {
                   // Lax-Friedrichs: the speed of c |u| phi (1 - phi) is at most c |u|
@@ -263,11 +637,16 @@ namespace Suspension::Solid
           u.evaluate(EvaluationFlags::values);
           phi.reinit(face);
           phi.gather_evaluate(in, EvaluationFlags::values);
+          Lanes profile;
+          if (thinc)
+            profile = phi.read_cell_data(reconstruction);
           VA outflow = 0.;
           for (const unsigned int q : phi.quadrature_point_indices())
             {
               const VA un   = u.get_value(q) * phi.get_normal_vector(q);
-              const VA flux = upwind(un, phi.get_value(q), VA(0.));
+              const VA phi_q = thinc ? seen_phi<dim>(profile, phi.quadrature_point(q), phi.get_value(q)) :
+                                       phi.get_value(q);
+              const VA flux = upwind(un, phi_q, VA(0.));
               phi.submit_value(-flux, q);
               outflow += flux * phi.JxW(q);
             }

@@ -1,11 +1,15 @@
 #pragma once
 
 #include <deal.II/base/quadrature_lib.h>
+#include <deal.II/base/tensor.h>
 #include <deal.II/base/symmetric_tensor.h>
 #include <deal.II/dofs/dof_handler.h>
 #include <deal.II/lac/affine_constraints.h>
 #include <deal.II/lac/la_parallel_vector.h>
 #include <deal.II/matrix_free/matrix_free.h>
+
+#include <array>
+#include <vector>
 
 namespace Suspension::Solid
 {
@@ -111,10 +115,66 @@ namespace Suspension::Solid
       thickness   = thickness_;
     }
 
+    /// THINC reconstruction of phi in the cells the interface cuts
+    /// (doc/method.md, "A sharp interface inside the cell"): sharpness beta
+    /// of the profile 1/2 (1 + tanh(beta (n.xi + d))) in the unit cell; 0:
+    /// off (phi is the DG polynomial everywhere).
+    void set_reconstruction(const double beta) { thinc_beta = beta; }
+
+    /// With the THINC reconstruction: phi in each interface cell replaced
+    /// by the projection of its profile onto the cell's polynomials, cell
+    /// means unchanged, so that what is measured and weighted (the stress
+    /// weight, D, the area) is the sharp profile the transport carries.
+    /// Returns whether it did (only with the reconstruction on).
+    bool project_to_profiles(VectorType &solution) const;
+
+    /// The profile of one cell as a function of x: 1/2 (1 + tanh(slope.x +
+    /// offset)), or none (the DG polynomial is used).
+    struct Reconstruction
+    {
+      Tensor<1, dim> slope;
+      double         offset = 0.;
+      bool           active = false;
+    };
+
+    /// The THINC profile of a cell of phi mean `mean` and reference-cell
+    /// gradient integral `gradient` (the cell [x0, x0 + h], axis-parallel),
+    /// with its mean equal to `mean` by the reference quadrature.
+    Reconstruction reconstruct(double mean, const Tensor<1, dim> &gradient,
+                               const Point<dim> &x0, const Tensor<1, dim> &h) const;
+
   private:
+    using Lanes = std::array<Reconstruction, VectorizedArray<double>::size()>;
+
+    /// fills `reconstruction` for the cells (and ghost cells) from src
+    void compute_reconstruction(const VectorType &src) const;
+
     MatrixFree<dim, double> matrix_free;
     bool                    with_B = false;
     double                  compression = 0., thickness = 0.;
     std::vector<VectorizedArray<double>> cell_size, face_size;
+
+    double thinc_beta = 0.;
+    /// the cell mean as a linear functional of the (lexicographic) phi
+    /// DoFs of a cell
+    std::vector<double> mean_weights;
+    /// lower corner, extents, volume and vertices of the cells and ghost
+    /// cells, by lane
+    std::vector<Point<dim>>     cell_corner;
+    std::vector<Tensor<1, dim>> cell_extent;
+    std::vector<double>         cell_volume;
+    /// quadrature of the unit cell that sets the profile's offset
+    std::vector<Point<dim>> profile_points;
+    std::vector<double>     profile_weights;
+    std::vector<unsigned int>           cell_vertices;
+    mutable std::vector<double>         vertex_mean, vertex_weight;
+    mutable std::vector<double>         cell_mean;
+    mutable AlignedVector<Lanes>        reconstruction;
+    mutable VectorType           ghosted;
+    /// the ghost layer of the mesh: vertices, volumes, phi DoFs by cell
+    std::vector<unsigned int>            ghost_layer_vertices;
+    std::vector<double>                  ghost_layer_volume;
+    std::vector<types::global_dof_index> ghost_layer_dofs;
+    mutable VectorType                   ghost_layer_values;
   };
 } // namespace Suspension::Solid
