@@ -47,9 +47,12 @@ namespace Suspension::Solid
       for (unsigned int v = 0; v < VA::size(); ++v)
         if (profile[v].active)
           {
+            // clamped to the cell's box: on a periodic face the point is
+            // given on the other side of the domain
             double argument = profile[v].offset;
             for (unsigned int d = 0; d < dim; ++d)
-              argument += profile[v].slope[d] * x[d][v];
+              argument += profile[v].slope[d] *
+                          std::clamp(x[d][v], profile[v].lower[d], profile[v].upper[d]);
             out[v] = 0.5 * (1. + std::tanh(argument));
           }
       return out;
@@ -370,6 +373,8 @@ namespace Suspension::Solid
                 gradient[c] += ((i >> c) & 1 ? value : -value) / (n_vertices / 2);
             }
           reconstruction[cell][v] = reconstruct(cell_mean[k], gradient, cell_corner[k], cell_extent[k]);
+          reconstruction[cell][v].lower = cell_corner[k];
+          reconstruction[cell][v].upper = cell_corner[k] + cell_extent[k];
         }
     if (n_ghosts == 0)
       return;
@@ -390,6 +395,8 @@ namespace Suspension::Solid
         {
           phi_dofs(cell, v);
           auto &r  = reconstruction[cell][v];
+          r.lower  = cell_corner[cell * n_lanes + v];
+          r.upper  = cell_corner[cell * n_lanes + v] + cell_extent[cell * n_lanes + v];
           r.active = ghosted(phi_indices[0]) == 1.;
           r.offset = ghosted(phi_indices[1]);
           for (unsigned int c = 0; c < dim; ++c)

@@ -135,6 +135,9 @@ namespace Suspension::Solid
       Tensor<1, dim> slope;
       double         offset = 0.;
       bool           active = false;
+      /// the cell's box: a point of a periodic face, given in the
+      /// coordinates of the other side, is moved onto this cell's face
+      Point<dim> lower, upper;
     };
 
     /// The THINC profile of a cell of phi mean `mean` and reference-cell
