@@ -14,18 +14,8 @@ K=${K:-12}; M=${M:-20} # checkpoint every K steps, stop after M
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 cd "$work" || exit 1
 
-# Resumed on another number of ranks: with the THINC reconstruction the
-# uninterrupted 1- and 2-rank runs of this adaptive scene take one different
-# coarsening at step 12 (500 against 497 cells; every field equal to 1e-11
-# before it, and equal to round-off on a uniform mesh), after which they
-# differ by 1e-6; the cross-rank resume is checked with the DG transport of
-# phi alone, whose 1- and 2-rank runs agree to 1e-8, and THINC is checked by
-# the same-rank resumes.
-extra=""
-[ "$ranks" -ne "$resume_ranks" ] && extra="Solid/Interface reconstruction=none"
 run() { # RANKS ARGS...
   n="$1"; shift
-  if [ -n "$extra" ]; then set -- "$@" --set "$extra"; fi
   if [ "$n" -eq 1 ]; then "$exe" "$@"; else "$mpiexec" -n "$n" "$exe" "$@"; fi
 }
 fail() { echo "FAILED: $*"; exit 1; }
