@@ -11,6 +11,7 @@
 
 #include <algorithm>
 #include <numeric>
+#include <sstream>
 #include <functional>
 #include <memory>
 
@@ -145,10 +146,13 @@ namespace Suspension::Solid
                 return p;
               }();
               if (std::abs(it->measure() - product) > 1e-10 * product)
-                throw std::runtime_error(
-                  "entry 'Solid/Interface reconstruction': THINC needs axis-parallel "
-                  "box cells, and the cell at " +
-                  Utilities::to_string(it->center()[0]) + ", ... is not one");
+                {
+                  std::ostringstream where;
+                  where << it->center();
+                  throw std::runtime_error(
+                    "entry 'Solid/Interface reconstruction': THINC needs axis-parallel "
+                    "box cells, and the cell centred at (" + where.str() + ") is not one");
+                }
               cell_corner[cell * n_lanes + v] = box.get_boundary_points().first;
               cell_volume[cell * n_lanes + v] = product;
               for (const unsigned int i : it->vertex_indices())
