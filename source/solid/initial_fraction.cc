@@ -187,17 +187,23 @@ namespace Suspension::Solid
     /// indicator changes along the edges (found by bisection), exact for a
     /// straight interface and O(size^3 curvature) otherwise; in 3D the same
     /// on the slices at Gauss points of the height
+    /// `straight` (2D) is set to false where the interface is not one
+    /// straight segment in the box: more than two edge crossings, or the points
+    /// just either side of the middle of the chord between them on the same
+    /// side (a corner of the shape inside the box, which the polygon cuts off).
     template <int dim>
     double indicator_fraction(const std::function<double(const Point<dim> &)> &value,
-                              const Point<dim> &lower, const Point<dim> &upper)
+                              const Point<dim> &lower, const Point<dim> &upper,
+                              bool &straight)
     {
+      straight = true;
       const auto slice_fraction = [&](const auto &at) {
         // at(s, t): the point of the xy-slice at local coordinates s, t in [0, 1]
         const std::array<std::array<double, 2>, 4> corner = {{{0., 0.}, {1., 0.}, {1., 1.}, {0., 1.}}};
         std::array<bool, 4> in;
         for (unsigned int i = 0; i < 4; ++i)
           in[i] = value(at(corner[i][0], corner[i][1])) > 0.5;
-        std::vector<std::array<double, 2>> polygon;
+        std::vector<std::array<double, 2>> polygon, crossings;
         for (unsigned int i = 0; i < 4; ++i)
           {
             const auto &a = corner[i], &b = corner[(i + 1) % 4];
@@ -216,7 +222,21 @@ namespace Suspension::Solid
                   }
                 const double m = 0.5 * (lo + hi);
                 polygon.push_back({a[0] + m * (b[0] - a[0]), a[1] + m * (b[1] - a[1])});
+                crossings.push_back(polygon.back());
               }
+          }
+        if (crossings.size() > 2)
+          straight = false; // two pieces of interface
+        else if (crossings.size() == 2)
+          {
+            constexpr double delta = 1e-3; // of the box
+            const auto &a = crossings[0], &b = crossings[1];
+            const double length = std::hypot(b[0] - a[0], b[1] - a[1]);
+            const double nx = -(b[1] - a[1]) / length, ny = (b[0] - a[0]) / length;
+            const double mx = 0.5 * (a[0] + b[0]), my = 0.5 * (a[1] + b[1]);
+            if ((value(at(mx + delta * nx, my + delta * ny)) > 0.5) ==
+                (value(at(mx - delta * nx, my - delta * ny)) > 0.5))
+              straight = false;
           }
         double area = 0.;
         for (unsigned int i = 0; i < polygon.size(); ++i)
@@ -238,12 +258,14 @@ namespace Suspension::Solid
         return slice_fraction([&](double s, double t) { return point(s, t, 0.); });
       else
         {
+          // the corners within the slices are not looked for: straight
           static const QGauss<1> gauss(4);
           double                 fraction = 0.;
           for (unsigned int q = 0; q < gauss.size(); ++q)
             fraction += gauss.weight(q) * slice_fraction([&](double s, double t) {
                           return point(s, t, gauss.point(q)[0]);
                         });
+          straight = true;
           return fraction;
         }
     }
@@ -382,9 +404,22 @@ namespace Suspension::Solid
                   lo         = std::min(lo, samples[q]);
                   hi         = std::max(hi, samples[q]);
                 }
-              // an indicator changes in this sub-box: bisect
-              const bool cut = k == -1 || (k == -2 && hi - lo > 0.5);
-              if (cut && depth < shape.max_depth)
+              // the moments are good enough from the Gauss points; the mean
+              // of an indicator that changes in the box is not
+              const bool indicator = std::all_of(samples.begin(), samples.end(), [](const double v) {
+                return v == 0. || v == 1.;
+              });
+              // an indicator changes in this sub-box: bisect; below the
+              // last level, only where the shape has a corner in it (up to
+              // 2^-8 of the last level's size: a corner cut off there is
+              // ~1e-10 of the cell)
+              const bool cut      = k == -1 || (k == -2 && hi - lo > 0.5);
+              bool       straight = true;
+              double     fraction = 0.;
+              const bool polygon  = cut && !shape.exact_measure && indicator;
+              if (polygon && depth >= shape.max_depth)
+                fraction = indicator_fraction<dim>(shape.value, real_lower, real_upper, straight);
+              if (cut && (depth < shape.max_depth || (!straight && depth < shape.max_depth + 8)))
                 {
                   for (unsigned int child = 0; child < GeometryInfo<dim>::max_children_per_cell; ++child)
                     {
@@ -410,13 +445,8 @@ namespace Suspension::Solid
                   for (unsigned int i = 0; i < n; ++i)
                     load[i] += w * scalar.shape_value(i, unit);
                 }
-              // the moments are good enough from the Gauss points; the mean
-              // of an indicator that changes in the box is not
-              const bool indicator = std::all_of(samples.begin(), samples.end(), [](const double v) {
-                return v == 0. || v == 1.;
-              });
-              if (cut && !shape.exact_measure && indicator)
-                mean = measure * indicator_fraction<dim>(shape.value, real_lower, real_upper);
+              if (polygon)
+                mean = measure * fraction;
               quadrature_mean += mean;
             };
           integrate(Point<dim>(), 1., 0);

@@ -39,6 +39,21 @@ namespace Suspension::Solid
       return b;
     }
 
+    // A face point seen from the cell [lower, upper] in one coordinate: on
+    // a periodic face it is given on the other side of the domain, a period
+    // away, and its image is the cell's far face (x below the box is the
+    // upper face, x above it the lower one); otherwise it lies on the box up
+    // to round-off, and clamping removes that.
+    inline double on_cell_face(const double x, const double lower, const double upper)
+    {
+      const double half = 0.5 * (upper - lower);
+      if (x < lower - half)
+        return upper;
+      if (x > upper + half)
+        return lower;
+      return std::clamp(x, lower, upper);
+    }
+
     // phi where the transport sees it: the cell's THINC profile at x in
     // the lanes that have one, the DG value elsewhere
     template <int dim, typename Lanes>
@@ -46,15 +61,13 @@ namespace Suspension::Solid
     {
       VA out = dg_value;
       for (unsigned int v = 0; v < VA::size(); ++v)
-        if (profile[v].active)
+        if (profile[v].weight > 0.)
           {
-            // clamped to the cell's box: on a periodic face the point is
-            // given on the other side of the domain
             double argument = profile[v].offset;
             for (unsigned int d = 0; d < dim; ++d)
               argument += profile[v].slope[d] *
-                          std::clamp(x[d][v], profile[v].lower[d], profile[v].upper[d]);
-            out[v] = 0.5 * (1. + std::tanh(argument));
+                          on_cell_face(x[d][v], profile[v].lower[d], profile[v].upper[d]);
+            out[v] += profile[v].weight * (0.5 * (1. + std::tanh(argument)) - dg_value[v]);
           }
       return out;
     }
@@ -245,9 +258,10 @@ namespace Suspension::Solid
     Reconstruction r;
     // cells that are (almost) all solid or all fluid, and flat cells (no
     // normal), keep their polynomial
-    constexpr double tiny = 1e-6;
-    const double     norm = gradient.norm();
-    if (!(mean > tiny && mean < 1. - tiny) || norm < 1e-8)
+    constexpr double tiny   = 1e-6;
+    const double     norm   = gradient.norm();
+    const double     margin = std::min(mean, 1. - mean);
+    if (!(margin > tiny) || norm < 1e-8)
       return r;
     const Tensor<1, dim> n    = gradient / norm;
     const double         beta = thinc_beta;
@@ -283,8 +297,9 @@ namespace Suspension::Solid
           break;
       }
     // beta (n.(xi - 1/2) + d) with xi = (x - x0) / h, as slope.x + offset
-    r.active = true;
-    r.offset = beta * d;
+    const double s = std::min(1., (margin - tiny) / tiny);
+    r.weight       = s * s * (3. - 2. * s);
+    r.offset       = beta * d;
     for (unsigned int c = 0; c < dim; ++c)
       {
         r.slope[c] = beta * n[c] / h[c];
@@ -385,10 +400,10 @@ namespace Suspension::Solid
     ghosted = 0.;
     for (unsigned int cell = 0; cell < n_owned; ++cell)
       for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
-        if (const auto &r = reconstruction[cell][v]; r.active)
+        if (const auto &r = reconstruction[cell][v]; r.weight > 0.)
           {
             phi_dofs(cell, v);
-            ghosted(phi_indices[0]) = 1.;
+            ghosted(phi_indices[0]) = r.weight;
             ghosted(phi_indices[1]) = r.offset;
             for (unsigned int c = 0; c < dim; ++c)
               ghosted(phi_indices[2 + c]) = r.slope[c];
@@ -401,7 +416,7 @@ namespace Suspension::Solid
           auto &r  = reconstruction[cell][v];
           r.lower  = cell_corner[cell * n_lanes + v];
           r.upper  = cell_corner[cell * n_lanes + v] + cell_extent[cell * n_lanes + v];
-          r.active = ghosted(phi_indices[0]) == 1.;
+          r.weight = ghosted(phi_indices[0]);
           r.offset = ghosted(phi_indices[1]);
           for (unsigned int c = 0; c < dim; ++c)
             r.slope[c] = ghosted(phi_indices[2 + c]);
@@ -426,15 +441,16 @@ namespace Suspension::Solid
       {
         bool any = false;
         for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
-          any = any || reconstruction[cell][v].active;
+          any = any || reconstruction[cell][v].weight > 0.;
         if (!any)
           continue;
         phi.reinit(cell);
         phi.read_dof_values_plain(solution);
         for (unsigned int i = 0; i < phi.dofs_per_cell; ++i)
           old_dofs[i] = phi.begin_dof_values()[i];
+        phi.evaluate(EvaluationFlags::values);
         for (const unsigned int q : phi.quadrature_point_indices())
-          values[q] = seen_phi<dim>(reconstruction[cell], phi.quadrature_point(q), VA(0.));
+          values[q] = seen_phi<dim>(reconstruction[cell], phi.quadrature_point(q), phi.get_value(q));
         inverse.transform_from_q_points_to_basis(1, values.data(), phi.begin_dof_values());
         for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
           {
@@ -444,7 +460,7 @@ namespace Suspension::Solid
             const double shift =
               cell_mean[cell * VA::size() + v] - new_mean;
             for (unsigned int i = 0; i < phi.dofs_per_cell; ++i)
-              phi.begin_dof_values()[i][v] = reconstruction[cell][v].active ?
+              phi.begin_dof_values()[i][v] = reconstruction[cell][v].weight > 0. ?
                                                phi.begin_dof_values()[i][v] + shift :
                                                old_dofs[i][v];
           }

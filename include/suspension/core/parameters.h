@@ -219,7 +219,7 @@ namespace Suspension::Parameters
     double                           interface_compression = 0.; // c of the compressive flux
     double                           interface_thickness   = 0.25; // eps / h of its diffusion
     /// THINC profile of phi in interface cells for the transport fluxes
-    bool                             thinc_reconstruction = false;
+    bool                             thinc_reconstruction = true;
     double                           thinc_sharpness      = 3.5; // beta, per cell
     double                           B_reset_fraction = -1.; // < 0: where H = 0
     double                           interface_relaxation = 0.; // R of B - I at rate R (1 - H)

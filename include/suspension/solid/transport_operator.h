@@ -134,7 +134,11 @@ namespace Suspension::Solid
     {
       Tensor<1, dim> slope;
       double         offset = 0.;
-      bool           active = false;
+      /// how much of the profile the transport sees, 1 - weight of the DG
+      /// polynomial: 0 where the cell mean is within 1e-6 of 0 or 1, 1
+      /// beyond 2e-6, a smooth step between (a switch would turn round-off
+      /// into differences of 1e-7 between partitions)
+      double         weight = 0.;
       /// the cell's box: a point of a periodic face, given in the
       /// coordinates of the other side, is moved onto this cell's face
       Point<dim> lower, upper;
