@@ -90,11 +90,18 @@ def main():
               r["peak_memory_MB"], r["mean_to_6"], r["mean_to_8"], r["max_to_8"]))
     fig, ax = plt.subplots(figsize=(6, 4))
     cpu = [r["cpu_s"] for r in rows]
-    ax.plot(cpu, [r["mean_to_8"] for r in rows], "o-", label="mean distance to t = 8")
-    ax.plot(cpu, [r["mean_to_6"] for r in rows], "s-", label="mean distance to t = 6")
+    ax.plot(cpu, [r["mean_to_8"] for r in rows], "o-", label="mean distance to t = 8 (THINC)")
+    ax.plot(cpu, [r["mean_to_6"] for r in rows], "s-", label="mean distance to t = 6 (THINC)")
     for r in rows:
         ax.annotate("%.0f cells/d" % r["cells_per_diameter"], (r["cpu_s"], r["mean_to_8"]),
                     textcoords="offset points", xytext=(4, 4), fontsize=8)
+    # the DG transport alone (session 8), if its results are kept
+    dg_path = os.path.join(HERE, "results_session8_dg.csv")
+    if os.path.exists(dg_path):
+        import csv
+        dg = [{k: float(v) for k, v in r.items()} for r in csv.DictReader(open(dg_path))]
+        ax.plot([r["cpu_s"] for r in dg], [r["mean_to_8"] for r in dg], "o:", color="grey",
+                label="to t = 8, DG transport alone (session 8)")
     ax.axhline(0.004, color="grey", ls="--", lw=0.8, label="target at 32 cells/d (issue 13)")
     ax.set_xscale("log")
     ax.set_xlabel("CPU seconds (one rank)")

@@ -720,6 +720,13 @@ namespace Suspension::Parameters
                       "the interface stays about a cell wide (doc/method.md, "
                       "'A sharp interface inside the cell'). Needs "
                       "axis-parallel cells and Degree >= 1.");
+    prm.declare_entry("THINC curvature", d.thinc_curvature ? "true" : "false", Patterns::Bool(),
+                      "With 'Interface reconstruction = THINC': true, the profile "
+                      "follows a curved surface, n.s + c |s_t|^2 in the unit cell "
+                      "(c from the divergence of the cell normals averaged at the "
+                      "vertices, as THINC/QQ); false, a plane. The curved profile "
+                      "keeps a rotating disc round (doc/method.md, 'A curved "
+                      "profile').");
     prm.declare_entry("THINC sharpness", std::to_string(d.thinc_sharpness),
                       Patterns::Double(0.1, 20.),
                       "beta of 'Interface reconstruction = THINC': the profile "
@@ -822,6 +829,7 @@ namespace Suspension::Parameters
     interface_thickness   = prm.get_double("Interface thickness");
     thinc_reconstruction  = prm.get("Interface reconstruction") == "THINC";
     thinc_sharpness       = prm.get_double("THINC sharpness");
+    thinc_curvature       = prm.get_bool("THINC curvature");
     if (thinc_reconstruction && degree == 0)
       throw InputError("Solid/Interface reconstruction",
                        "THINC needs Degree >= 1 (the profiles reach the ghost cells "

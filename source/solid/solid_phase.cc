@@ -120,7 +120,8 @@ namespace Suspension::Solid
     // before reinit, which prepares the cell geometry the profiles need
     transport.set_reconstruction(parameters.solid.thinc_reconstruction ?
                                    parameters.solid.thinc_sharpness :
-                                   0.);
+                                   0.,
+                                 parameters.solid.thinc_curvature);
     transport.reinit(dof_handler, fluid_space.dof_velocity, velocity_constraints,
                      parameters.solid.elastic());
     transport.set_compression(parameters.solid.interface_compression,

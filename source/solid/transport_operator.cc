@@ -63,11 +63,23 @@ namespace Suspension::Solid
       for (unsigned int v = 0; v < VA::size(); ++v)
         if (profile[v].weight > 0.)
           {
-            double argument = profile[v].offset;
+            const auto &r        = profile[v];
+            double      argument = r.offset;
+            // for the curved profile: s = (x - centre) / h, n from the slope
+            double s2 = 0., sn = 0., nn = 0.;
             for (unsigned int d = 0; d < dim; ++d)
-              argument += profile[v].slope[d] *
-                          on_cell_face(x[d][v], profile[v].lower[d], profile[v].upper[d]);
-            out[v] += profile[v].weight * (0.5 * (1. + std::tanh(argument)) - dg_value[v]);
+              {
+                const double y = on_cell_face(x[d][v], r.lower[d], r.upper[d]);
+                argument += r.slope[d] * y;
+                const double h = r.upper[d] - r.lower[d];
+                const double s = (y - 0.5 * (r.lower[d] + r.upper[d])) / h;
+                s2 += s * s;
+                sn += r.slope[d] * h * s;
+                nn += r.slope[d] * h * r.slope[d] * h;
+              }
+            if (r.curvature != 0.)
+              argument += r.curvature * (s2 - sn * sn / nn);
+            out[v] += r.weight * (0.5 * (1. + std::tanh(argument)) - dg_value[v]);
           }
       return out;
     }
@@ -214,6 +226,10 @@ namespace Suspension::Solid
         cell_mean.assign(n_cells * n_lanes, 0.);
         if (matrix_free.n_ghost_cell_batches() > 0)
           matrix_free.initialize_dof_vector(ghosted, 0);
+        if (matrix_free.n_ghost_cell_batches() > 0 && thinc_curved)
+          matrix_free.initialize_dof_vector(ghosted_curvature, 0);
+        cell_normal.assign(thinc_curved ? n_cells * n_lanes : 0, Tensor<1, dim>());
+        vertex_normal.assign(thinc_curved ? vertex_mean.size() : 0, Tensor<1, dim>());
 
         // Youngs' normal of an owned cell needs the means of all cells that
         // share a vertex with it; MatrixFree's ghost cells are only those
@@ -246,6 +262,9 @@ namespace Suspension::Solid
             DoFTools::extract_locally_relevant_dofs(dof_solid, relevant);
             ghost_layer_values.reinit(dof_solid.locally_owned_dofs(), relevant,
                                       dof_solid.get_communicator());
+            if (thinc_curved)
+              normal_values.reinit(dof_solid.locally_owned_dofs(), relevant,
+                                   dof_solid.get_communicator());
           }
       }
   }
@@ -253,7 +272,8 @@ namespace Suspension::Solid
   template <int dim>
   typename TransportOperator<dim>::Reconstruction
   TransportOperator<dim>::reconstruct(const double mean, const Tensor<1, dim> &gradient,
-                                      const Point<dim> &x0, const Tensor<1, dim> &h) const
+                                      const Point<dim> &x0, const Tensor<1, dim> &h,
+                                      const double divergence) const
   {
     Reconstruction r;
     // cells that are (almost) all solid or all fluid, and flat cells (no
@@ -267,14 +287,29 @@ namespace Suspension::Solid
     const double         beta = thinc_beta;
     // the profile's mean is increasing in d: Newton within a bracket where
     // the profile is below 1e-6 (above 1 - 1e-6) in the whole cell
+    // the curved profile: P(s) = n.s + c |s_t|^2 follows the level set of
+    // a unit-normal field of divergence div n to second order, c =
+    // h div n / (2 (dim - 1)) (a disc of radius R, n inwards: c = -h/2R);
+    // radii below a cell are not resolved and are cut off there
+    double h_mean = 1.;
+    for (unsigned int c = 0; c < dim; ++c)
+      h_mean *= h[c];
+    h_mean = std::pow(h_mean, 1. / dim);
+    const double curve = std::clamp(0.5 * h_mean * divergence / (dim - 1), -0.5, 0.5);
     std::array<double, 64> projection; // at most QGauss<3>(4)
     for (unsigned int q = 0; q < profile_points.size(); ++q)
       {
-        projection[q] = 0.;
+        double sn = 0., s2 = 0.;
         for (unsigned int c = 0; c < dim; ++c)
-          projection[q] += n[c] * (profile_points[q][c] - 0.5);
+          {
+            const double sc = profile_points[q][c] - 0.5;
+            sn += n[c] * sc;
+            s2 += sc * sc;
+          }
+        projection[q] = sn + curve * (s2 - sn * sn);
       }
-    double lo = -1. - 8. / beta, hi = 1. + 8. / beta;
+    const double reach = 1. + std::abs(curve) * dim / 4. + 8. / beta;
+    double       lo = -reach, hi = reach;
     // start from the exact offset of a profile normal to a cell face, whose
     // mean is 1/2 + ln(cosh(beta (d + 1/2)) / cosh(beta (d - 1/2))) / (2 beta)
     const double q = std::exp(beta * (2. * mean - 1.)), b = std::exp(beta);
@@ -299,6 +334,7 @@ namespace Suspension::Solid
     // beta (n.(xi - 1/2) + d) with xi = (x - x0) / h, as slope.x + offset
     const double s = std::min(1., (margin - tiny) / tiny);
     r.weight       = s * s * (3. - 2. * s);
+    r.curvature    = beta * curve;
     r.offset       = beta * d;
     for (unsigned int c = 0; c < dim; ++c)
       {
@@ -377,38 +413,115 @@ namespace Suspension::Solid
         ghost_layer_values.zero_out_ghost_values();
       }
 
+    // the gradient (integral over the unit cell) of an owned cell
+    const auto unit_gradient = [&](const unsigned int k) {
+      Tensor<1, dim> gradient;
+      for (unsigned int i = 0; i < n_vertices; ++i)
+        {
+          const unsigned int vertex = cell_vertices[k * n_vertices + i];
+          const double       value  = vertex_mean[vertex] / vertex_weight[vertex];
+          for (unsigned int c = 0; c < dim; ++c)
+            gradient[c] += ((i >> c) & 1 ? value : -value) / (n_vertices / 2);
+        }
+      return gradient;
+    };
+    // 2b. for the curved profile, div n: the unit normals of the cells
+    // (owned, then the ghost layer through a vector with all locally
+    // relevant DoFs), averaged at the vertices; div n of a cell is the
+    // divergence of the multilinear interpolant of its vertex normals
+    if (thinc_curved)
+      {
+        std::fill(cell_normal.begin(), cell_normal.end(), Tensor<1, dim>());
+        std::fill(vertex_normal.begin(), vertex_normal.end(), Tensor<1, dim>());
+        const auto add_to_vertices = [&](const unsigned int *vertices, const double volume,
+                                         const Tensor<1, dim> &normal) {
+          for (unsigned int i = 0; i < n_vertices; ++i)
+            vertex_normal[vertices[i]] += volume * normal;
+        };
+        const bool exchange = !ghost_layer_volume.empty();
+        if (exchange)
+          normal_values = 0.;
+        for (unsigned int cell = 0; cell < n_owned; ++cell)
+          for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+            {
+              const unsigned int k = cell * n_lanes + v;
+              Tensor<1, dim>     g = unit_gradient(k);
+              for (unsigned int c = 0; c < dim; ++c)
+                g[c] /= cell_extent[k][c];
+              if (g.norm() < 1e-8 / std::pow(cell_volume[k], 1. / dim))
+                continue;
+              cell_normal[k] = g / g.norm();
+              add_to_vertices(&cell_vertices[k * n_vertices], cell_volume[k], cell_normal[k]);
+              if (exchange)
+                {
+                  phi_dofs(cell, v);
+                  for (unsigned int c = 0; c < dim; ++c)
+                    normal_values(phi_indices[c]) = cell_normal[k][c];
+                }
+            }
+        if (exchange)
+          {
+            normal_values.update_ghost_values();
+            for (std::size_t g = 0; g < ghost_layer_volume.size(); ++g)
+              {
+                Tensor<1, dim> normal;
+                for (unsigned int c = 0; c < dim; ++c)
+                  normal[c] = normal_values(ghost_layer_dofs[g * n_dofs + c]);
+                if (normal.norm() > 0.)
+                  add_to_vertices(&ghost_layer_vertices[g * n_vertices], ghost_layer_volume[g], normal);
+              }
+            normal_values.zero_out_ghost_values();
+          }
+      }
+    const auto divergence_of_normals = [&](const unsigned int k) {
+      double divergence = 0.;
+      for (unsigned int i = 0; i < n_vertices; ++i)
+        {
+          const Tensor<1, dim> &sum = vertex_normal[cell_vertices[k * n_vertices + i]];
+          const double          norm = sum.norm();
+          if (norm == 0.)
+            return 0.; // a vertex without a normal: no curvature
+          for (unsigned int c = 0; c < dim; ++c)
+            divergence += ((i >> c) & 1 ? sum[c] : -sum[c]) / norm / (n_vertices / 2) /
+                          cell_extent[k][c];
+        }
+      return divergence;
+    };
+
     // 3. the profiles of the owned cells; the ghost cells receive theirs
     // through the phi DoFs of a scratch vector
     for (unsigned int cell = 0; cell < n_owned; ++cell)
       for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
         {
-          const unsigned int k = cell * n_lanes + v;
-          Tensor<1, dim>     gradient; // its integral over the unit cell
-          for (unsigned int i = 0; i < n_vertices; ++i)
-            {
-              const unsigned int vertex = cell_vertices[k * n_vertices + i];
-              const double       value  = vertex_mean[vertex] / vertex_weight[vertex];
-              for (unsigned int c = 0; c < dim; ++c)
-                gradient[c] += ((i >> c) & 1 ? value : -value) / (n_vertices / 2);
-            }
-          reconstruction[cell][v] = reconstruct(cell_mean[k], gradient, cell_corner[k], cell_extent[k]);
+          const unsigned int k        = cell * n_lanes + v;
+          const Tensor<1, dim> gradient = unit_gradient(k);
+          const double divergence =
+            thinc_curved && cell_mean[k] > 1e-6 && cell_mean[k] < 1. - 1e-6 ? divergence_of_normals(k) : 0.;
+          reconstruction[cell][v] =
+            reconstruct(cell_mean[k], gradient, cell_corner[k], cell_extent[k], divergence);
           reconstruction[cell][v].lower = cell_corner[k];
           reconstruction[cell][v].upper = cell_corner[k] + cell_extent[k];
         }
     if (n_ghosts == 0)
       return;
     ghosted = 0.;
+    if (thinc_curved)
+      ghosted_curvature = 0.;
     for (unsigned int cell = 0; cell < n_owned; ++cell)
       for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
         if (const auto &r = reconstruction[cell][v]; r.weight > 0.)
           {
             phi_dofs(cell, v);
+            if (thinc_curved)
+              ghosted_curvature(phi_indices[0]) = r.curvature;
             ghosted(phi_indices[0]) = r.weight;
             ghosted(phi_indices[1]) = r.offset;
             for (unsigned int c = 0; c < dim; ++c)
               ghosted(phi_indices[2 + c]) = r.slope[c];
           }
     ghosted.update_ghost_values();
+    if (thinc_curved)
+      ghosted_curvature.update_ghost_values();
     for (unsigned int cell = n_owned; cell < n_owned + n_ghosts; ++cell)
       for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
         {
@@ -416,12 +529,15 @@ namespace Suspension::Solid
           auto &r  = reconstruction[cell][v];
           r.lower  = cell_corner[cell * n_lanes + v];
           r.upper  = cell_corner[cell * n_lanes + v] + cell_extent[cell * n_lanes + v];
-          r.weight = ghosted(phi_indices[0]);
+          r.weight    = ghosted(phi_indices[0]);
+          r.curvature = thinc_curved ? ghosted_curvature(phi_indices[0]) : 0.;
           r.offset = ghosted(phi_indices[1]);
           for (unsigned int c = 0; c < dim; ++c)
             r.slope[c] = ghosted(phi_indices[2 + c]);
         }
     ghosted.zero_out_ghost_values();
+    if (thinc_curved)
+      ghosted_curvature.zero_out_ghost_values();
   }
 
   template <int dim>

@@ -221,6 +221,7 @@ namespace Suspension::Parameters
     /// THINC profile of phi in interface cells for the transport fluxes
     bool                             thinc_reconstruction = true;
     double                           thinc_sharpness      = 3.5; // beta, per cell
+    bool                             thinc_curvature      = true; // curved profile
     double                           B_reset_fraction = -1.; // < 0: where H = 0
     double                           interface_relaxation = 0.; // R of B - I at rate R (1 - H)
     /// algebraic sharpening of phi after every `sharpening_interval` steps

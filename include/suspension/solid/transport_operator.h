@@ -119,7 +119,11 @@ namespace Suspension::Solid
     /// (doc/method.md, "A sharp interface inside the cell"): sharpness beta
     /// of the profile 1/2 (1 + tanh(beta (n.xi + d))) in the unit cell; 0:
     /// off (phi is the DG polynomial everywhere).
-    void set_reconstruction(const double beta) { thinc_beta = beta; }
+    void set_reconstruction(const double beta, const bool curved = false)
+    {
+      thinc_beta   = beta;
+      thinc_curved = curved;
+    }
 
     /// With the THINC reconstruction: phi in each interface cell replaced
     /// by the projection of its profile onto the cell's polynomials, cell
@@ -139,6 +143,10 @@ namespace Suspension::Solid
       /// beyond 2e-6, a smooth step between (a switch would turn round-off
       /// into differences of 1e-7 between partitions)
       double         weight = 0.;
+      /// beta c of the curved profile (0: a plane): the argument gains
+      /// beta c |s_t|^2, s_t the part of s = (x - centre)/h normal to the
+      /// profile's normal (slope / |slope| in unit-cell coordinates)
+      double         curvature = 0.;
       /// the cell's box: a point of a periodic face, given in the
       /// coordinates of the other side, is moved onto this cell's face
       Point<dim> lower, upper;
@@ -147,8 +155,11 @@ namespace Suspension::Solid
     /// The THINC profile of a cell of phi mean `mean` and reference-cell
     /// gradient integral `gradient` (the cell [x0, x0 + h], axis-parallel),
     /// with its mean equal to `mean` by the reference quadrature.
+    /// `divergence`: div n of the unit normal field (physical units), whose
+    /// level sets the curved profile follows (0: a plane).
     Reconstruction reconstruct(double mean, const Tensor<1, dim> &gradient,
-                               const Point<dim> &x0, const Tensor<1, dim> &h) const;
+                               const Point<dim> &x0, const Tensor<1, dim> &h,
+                               double divergence = 0.) const;
 
   private:
     using Lanes = std::array<Reconstruction, VectorizedArray<double>::size()>;
@@ -161,7 +172,8 @@ namespace Suspension::Solid
     double                  compression = 0., thickness = 0.;
     std::vector<VectorizedArray<double>> cell_size, face_size;
 
-    double thinc_beta = 0.;
+    double thinc_beta   = 0.;
+    bool   thinc_curved = false;
     /// the cell mean as a linear functional of the (lexicographic) phi
     /// DoFs of a cell
     std::vector<double> mean_weights;
@@ -177,7 +189,11 @@ namespace Suspension::Solid
     mutable std::vector<double>         vertex_mean, vertex_weight;
     mutable std::vector<double>         cell_mean;
     mutable AlignedVector<Lanes>        reconstruction;
-    mutable VectorType           ghosted;
+    mutable VectorType           ghosted, ghosted_curvature;
+    /// unit normals of the cells and ghost-layer cells (zero: none), and
+    /// their volume-weighted sums at the vertices, for div n
+    mutable std::vector<Tensor<1, dim>> cell_normal, vertex_normal;
+    mutable VectorType                  normal_values;
     /// the ghost layer of the mesh: vertices, volumes, phi DoFs by cell
     std::vector<unsigned int>            ghost_layer_vertices;
     std::vector<double>                  ghost_layer_volume;
