@@ -71,6 +71,8 @@ namespace Suspension::Solid
               {
                 const double y = on_cell_face(x[d][v], r.lower[d], r.upper[d]);
                 argument += r.slope[d] * y;
+                if (r.curvature == 0.)
+                  continue;
                 const double h = r.upper[d] - r.lower[d];
                 const double s = (y - 0.5 * (r.lower[d] + r.upper[d])) / h;
                 s2 += s * s;
@@ -228,7 +230,6 @@ namespace Suspension::Solid
           matrix_free.initialize_dof_vector(ghosted, 0);
         if (matrix_free.n_ghost_cell_batches() > 0 && thinc_curved)
           matrix_free.initialize_dof_vector(ghosted_curvature, 0);
-        cell_normal.assign(thinc_curved ? n_cells * n_lanes : 0, Tensor<1, dim>());
         vertex_normal.assign(thinc_curved ? vertex_mean.size() : 0, Tensor<1, dim>());
 
         // Youngs' normal of an owned cell needs the means of all cells that
@@ -431,7 +432,6 @@ namespace Suspension::Solid
     // divergence of the multilinear interpolant of its vertex normals
     if (thinc_curved)
       {
-        std::fill(cell_normal.begin(), cell_normal.end(), Tensor<1, dim>());
         std::fill(vertex_normal.begin(), vertex_normal.end(), Tensor<1, dim>());
         const auto add_to_vertices = [&](const unsigned int *vertices, const double volume,
                                          const Tensor<1, dim> &normal) {
@@ -450,13 +450,13 @@ namespace Suspension::Solid
                 g[c] /= cell_extent[k][c];
               if (g.norm() < 1e-8 / std::pow(cell_volume[k], 1. / dim))
                 continue;
-              cell_normal[k] = g / g.norm();
-              add_to_vertices(&cell_vertices[k * n_vertices], cell_volume[k], cell_normal[k]);
+              const Tensor<1, dim> normal = g / g.norm();
+              add_to_vertices(&cell_vertices[k * n_vertices], cell_volume[k], normal);
               if (exchange)
                 {
                   phi_dofs(cell, v);
                   for (unsigned int c = 0; c < dim; ++c)
-                    normal_values(phi_indices[c]) = cell_normal[k][c];
+                    normal_values(phi_indices[c]) = normal[c];
                 }
             }
         if (exchange)

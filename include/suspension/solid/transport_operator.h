@@ -190,9 +190,9 @@ namespace Suspension::Solid
     mutable std::vector<double>         cell_mean;
     mutable AlignedVector<Lanes>        reconstruction;
     mutable VectorType           ghosted, ghosted_curvature;
-    /// unit normals of the cells and ghost-layer cells (zero: none), and
-    /// their volume-weighted sums at the vertices, for div n
-    mutable std::vector<Tensor<1, dim>> cell_normal, vertex_normal;
+    /// volume-weighted sums of the cells' unit normals at the vertices,
+    /// for div n
+    mutable std::vector<Tensor<1, dim>> vertex_normal;
     mutable VectorType                  normal_values;
     /// the ghost layer of the mesh: vertices, volumes, phi DoFs by cell
     std::vector<unsigned int>            ghost_layer_vertices;
