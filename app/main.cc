@@ -4,6 +4,7 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/parameter_handler.h>
 
+#include <suspension/core/memory.h>
 #include <suspension/core/parameters.h>
 #include <suspension/core/study.h>
 
@@ -104,6 +105,8 @@ int main(int argc, char *argv[])
           dim = std::stoi(value);
       parameters             = Parameters::read(filename, dim, overrides);
       parameters.checkpoint.resume = resume;
+      // a mesh that cannot fit stops here, before anything is written
+      check_memory(parameters, MPI_COMM_WORLD);
     }
   catch (const Parameters::InputError &e)
     {

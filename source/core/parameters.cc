@@ -578,7 +578,17 @@ namespace Suspension::Parameters
                       "(BoomerAMG, few iterations, a set-up whenever the mesh "
                       "or the time step changes) or jacobi (no set-up; enough "
                       "when the mass term (alpha/dt) M dominates nu K, i.e. "
-                      "nu dt / h^2 is small, as in adaptive suspension runs).");
+                      "nu dt / h^2 is small, as in adaptive suspension runs). "
+                      "Used with 'Momentum operator = assembled' only.");
+    prm.declare_entry("Momentum operator",
+                      "matrix-free",
+                      Patterns::Selection("assembled|matrix-free"),
+                      "How the momentum predictor's (alpha/dt) M + nu K is "
+                      "applied: assembled (PETSc matrices M, K and A, "
+                      "rebuilt with the mesh and the time step) or "
+                      "matrix-free (FEEvaluation on the fly, no velocity "
+                      "matrix in memory, CG with the Jacobi preconditioner "
+                      "of its diagonal; doc/method.md).");
     prm.leave_subsection();
   }
 
@@ -598,6 +608,7 @@ namespace Suspension::Parameters
                          ConvectionForm::skew_symmetric;
     solver_tolerance = prm.get_double("Linear solver tolerance");
     jacobi_momentum  = prm.get("Momentum preconditioner") == "jacobi";
+    matrix_free_momentum = prm.get("Momentum operator") == "matrix-free";
     prm.leave_subsection();
     if (mode == VelocityMode::prescribed)
       check_expression("Fluid solver/Prescribed velocity", prescribed_velocity, dim, dim);

@@ -8,6 +8,7 @@
 #include <boost/serialization/utility.hpp>
 #include <boost/serialization/vector.hpp>
 
+#include <suspension/core/memory.h>
 #include <suspension/core/simulation.h>
 #include <suspension/fluid/body_force.h>
 #include <suspension/mesh/resolution_check.h>
@@ -70,6 +71,7 @@ namespace Suspension
   {
     fluid.set_timer(timer);
     operators.jacobi_momentum = parameters.fluid_solver.jacobi_momentum;
+    operators.matrix_free_momentum = parameters.fluid_solver.matrix_free_momentum;
     operators.step_matrix     = parameters.solid.semi_implicit && parameters.solid.elastic();
     if (parameters.fluid_solver.mode == Parameters::VelocityMode::prescribed)
       prescribed_velocity = make_function<dim>(parameters.fluid_solver.prescribed_velocity, dim);
@@ -578,7 +580,10 @@ namespace Suspension
         statistics.add_value("theta_deg", shape.inclination);
         statistics.add_value("solid_area", shape.solid_area);
         statistics.add_value("D_phi", shape.taylor_deformation_phi);
-        columns.insert(columns.end(), {"D", "theta_deg", "solid_area", "D_phi"});
+        statistics.add_value("solid_area_subcell", shape.solid_area_subcell);
+        statistics.add_value("D_half", shape.taylor_deformation_half);
+        columns.insert(columns.end(),
+                       {"D", "theta_deg", "solid_area", "D_phi", "solid_area_subcell", "D_half"});
         if (parameters.solid.elastic())
           {
             statistics.add_value("D_B", shape.taylor_deformation_B);
@@ -1103,6 +1108,12 @@ namespace Suspension
               << (std::max(c.max_u_deviation, c.max_v_deviation) <= 0.02 ? "yes" : "no")
               << std::endl;
       }
+
+    if (parameters.output.timer_summary)
+      pcout << "  "
+            << memory_line(space.dof_velocity.n_dofs(),
+                           estimate_memory(parameters, communicator).bytes_per_rank, communicator)
+            << std::endl;
 
     RunSummary summary;
     summary.final_errors = last_errors;

@@ -94,8 +94,11 @@ namespace Suspension::Fluid
   void FluidOperators<dim>::reinit(const FluidSpace<dim> &space)
   {
     communicator = space.communicator();
-    make_matrices({&M, &K, &A}, space.dof_velocity, space.owned_velocity,
-                  space.relevant_velocity, space.velocity_constraints, true);
+    if (matrix_free_momentum)
+      momentum_operator.reinit(space);
+    else
+      make_matrices({&M, &K, &A}, space.dof_velocity, space.owned_velocity,
+                    space.relevant_velocity, space.velocity_constraints, true);
     if (step_matrix)
       make_matrices({&A_step}, space.dof_velocity, space.owned_velocity,
                     space.relevant_velocity, space.velocity_constraints, false);
@@ -180,8 +183,11 @@ namespace Suspension::Fluid
             }
           cell->get_dof_indices(u_dofs);
           pcell->get_dof_indices(p_dofs);
-          space.velocity_constraints.distribute_local_to_global(cell_M, u_dofs, M);
-          space.velocity_constraints.distribute_local_to_global(cell_K, u_dofs, K);
+          if (!matrix_free_momentum)
+            {
+              space.velocity_constraints.distribute_local_to_global(cell_M, u_dofs, M);
+              space.velocity_constraints.distribute_local_to_global(cell_K, u_dofs, K);
+            }
           space.velocity_constraints.distribute_local_to_global(cell_force, u_dofs, unit_force);
           flux_weights.add(u_dofs, cell_flux);
           space.increment_constraints.distribute_local_to_global(cell_L, p_dofs, L);
@@ -189,7 +195,8 @@ namespace Suspension::Fluid
           space.pressure_constraints.distribute_local_to_global(cell_D, p_dofs, no_constraints, u_dofs, D);
         }
     for (auto *m : {&M, &K, &L, &Mp, &D})
-      m->compress(VectorOperation::add);
+      if (m->m() > 0)
+        m->compress(VectorOperation::add);
     flux_weights.compress(VectorOperation::add);
     unit_force.compress(VectorOperation::add);
 
@@ -209,13 +216,18 @@ namespace Suspension::Fluid
   {
     if (alpha_over_dt == momentum_alpha_over_dt && nu == momentum_nu)
       return;
+    momentum_alpha_over_dt = alpha_over_dt;
+    momentum_nu            = nu;
+    if (matrix_free_momentum)
+      {
+        momentum_operator.set_coefficients(alpha_over_dt, nu);
+        return;
+      }
     A.copy_from(K);
     A *= nu;
     // MatrixBase::add() would assume different patterns and rebuild A
     const PetscErrorCode ierr = MatAXPY(A, alpha_over_dt, M, SAME_NONZERO_PATTERN);
     AssertThrow(ierr == 0, ExcPETScError(ierr));
-    momentum_alpha_over_dt = alpha_over_dt;
-    momentum_nu            = nu;
 
     if (jacobi_momentum)
       {
@@ -230,6 +242,8 @@ namespace Suspension::Fluid
   unsigned int FluidOperators<dim>::solve_momentum(VectorType &x, const VectorType &b,
                                                    const double tolerance) const
   {
+    if (matrix_free_momentum)
+      return momentum_operator.solve(x, b, tolerance);
     if (jacobi_momentum)
       return cg_solve(A, x, b, *jacobi_momentum_preconditioner, tolerance, communicator);
     return cg_solve(A, x, b, *amg_momentum, tolerance, communicator);

@@ -4,12 +4,14 @@
 #include <deal.II/base/symmetric_tensor.h>
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/mapping_q1.h>
+#include <deal.II/grid/grid_tools.h>
 #include <deal.II/matrix_free/fe_evaluation.h>
 #include <deal.II/matrix_free/operators.h>
 
 #include <suspension/solid/transport_operator.h>
 
 #include <algorithm>
+#include <cstdlib>
 #include <numeric>
 #include <sstream>
 #include <functional>
@@ -123,6 +125,17 @@ namespace Suspension::Solid
     // quadrature 0: integrals; 1: k+1 Gauss points for the inverse mass
     const std::vector<Quadrature<1>> quadratures = {QGauss<1>(n_q), QGauss<1>(k + 1)};
     matrix_free.reinit(MappingQ1<dim>(), dofs, constraints, quadratures, data);
+
+    // B everywhere until mark_solid_cells() says where
+    const unsigned int n_batches = matrix_free.n_cell_batches() + matrix_free.n_ghost_cell_batches();
+    b_active.resize_fast(n_batches);
+    for (unsigned int cell = 0; cell < n_batches; ++cell)
+      b_active[cell] = 1.;
+    lane_cell_index.assign(n_batches * VectorizedArray<double>::size(), numbers::invalid_unsigned_int);
+    for (unsigned int cell = 0; cell < n_batches; ++cell)
+      for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+        lane_cell_index[cell * VectorizedArray<double>::size() + v] =
+          matrix_free.get_cell_iterator(cell, v)->active_cell_index();
 
     // cell sizes for the interface diffusion: a cell's smallest vertex
     // distance, a face's the smaller of its two cells'
@@ -598,6 +611,64 @@ namespace Suspension::Solid
   }
 
   template <int dim>
+  unsigned int TransportOperator<dim>::mark_solid_cells(const VectorType &solution)
+  {
+    if (!with_B)
+      return 0;
+    constexpr double   threshold = 1e-8;
+    const unsigned int n_lanes   = VectorizedArray<double>::size();
+    const auto        &tria      = matrix_free.get_dof_handler(0).get_triangulation();
+    // 1. cells that hold solid (owned), then their owners' marks on the ghosts
+    std::vector<unsigned char> holds(tria.n_active_cells(), 0), marked;
+    FEEvaluation<dim, -1, 0, 1, double> phi(matrix_free, 0, 0, 0);
+    for (unsigned int cell = 0; cell < matrix_free.n_cell_batches(); ++cell)
+      {
+        phi.reinit(cell);
+        phi.read_dof_values_plain(solution);
+        for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+          for (unsigned int i = 0; i < phi.dofs_per_cell; ++i)
+            if (phi.begin_dof_values()[i][v] > threshold)
+              {
+                holds[lane_cell_index[cell * n_lanes + v]] = 1;
+                break;
+              }
+      }
+    const auto exchange = [&](std::vector<unsigned char> &flags) {
+      using Iterator = typename Triangulation<dim>::active_cell_iterator;
+      GridTools::exchange_cell_data_to_ghosts<unsigned char, Triangulation<dim>>(
+        tria,
+        [&](const Iterator &cell) { return std_cxx17::optional<unsigned char>(flags[cell->active_cell_index()]); },
+        [&](const Iterator &cell, const unsigned char &value) { flags[cell->active_cell_index()] = value; });
+    };
+    exchange(holds);
+    // 2. and their face neighbours (periodic and hanging faces included):
+    // the faces of owned cells are the inner faces of the MatrixFree
+    marked = holds;
+    for (unsigned int face = 0; face < matrix_free.n_inner_face_batches(); ++face)
+      {
+        const auto &info = matrix_free.get_face_info(face);
+        for (unsigned int v = 0; v < matrix_free.n_active_entries_per_face_batch(face); ++v)
+          {
+            const unsigned int in  = lane_cell_index[info.cells_interior[v]];
+            const unsigned int out = lane_cell_index[info.cells_exterior[v]];
+            if (holds[in] || holds[out])
+              marked[in] = marked[out] = 1;
+          }
+      }
+    exchange(marked);
+    unsigned int n_marked = 0;
+    for (unsigned int cell = 0; cell < b_active.size(); ++cell)
+      for (unsigned int v = 0; v < n_lanes; ++v)
+        {
+          const unsigned int index = lane_cell_index[cell * n_lanes + v];
+          b_active[cell][v] = (index != numbers::invalid_unsigned_int && marked[index]) ? 1. : 0.;
+          if (cell < matrix_free.n_cell_batches() && b_active[cell][v] > 0.)
+            ++n_marked;
+        }
+    return n_marked;
+  }
+
+  template <int dim>
   void TransportOperator<dim>::apply(const VectorType &src,
                                      VectorType       &dst,
                                      const VectorType &velocity,
@@ -607,6 +678,16 @@ namespace Suspension::Solid
     using Operation =
       std::function<void(const MatrixFree<dim, double> &, VectorType &, const VectorType &, const Range &)>;
     const bool compress         = compression > 0.;
+    // B only in the cells mark_solid_cells() marked; I outside
+    const auto any_lane = [](const VA &active) {
+      for (unsigned int v = 0; v < VA::size(); ++v)
+        if (active[v] > 0.)
+          return true;
+      return false;
+    };
+    Tensor<1, n_B, VA> identity;
+    for (unsigned int d = 0; d < dim; ++d)
+      identity[d] = 1.; // unrolled order starts with the diagonal
     const bool thinc            = thinc_beta > 0.;
     if (thinc)
       compute_reconstruction(src);
@@ -660,9 +741,10 @@ namespace Suspension::Solid
               phi.submit_gradient(flux, q);
             }
           phi.integrate_scatter(EvaluationFlags::gradients, out);
-          if (!with_B)
+          if (!with_B || !any_lane(b_active[cell]))
             continue;
-          auto &b = *b_ptr;
+          const VA active = b_active[cell];
+          auto    &b      = *b_ptr;
           b.reinit(cell);
           b.gather_evaluate(in, EvaluationFlags::values);
           for (const unsigned int q : b.quadrature_point_indices())
@@ -675,9 +757,9 @@ namespace Suspension::Solid
                 trace(grad_u) * B + grad_u * B + B * transpose(grad_u);
               Tensor<1, n_B, Tensor<1, dim, VA>> flux;
               for (unsigned int c = 0; c < n_B; ++c)
-                flux[c] = velocity_q * bq[c];
+                flux[c] = velocity_q * (bq[c] * active);
               b.submit_gradient(flux, q);
-              b.submit_value(to_vector<dim>(source), q);
+              b.submit_value(to_vector<dim>(source) * active, q);
             }
           b.integrate_scatter(EvaluationFlags::values | EvaluationFlags::gradients, out);
         }
@@ -748,17 +830,33 @@ namespace Suspension::Solid
           auto &b_p = *bp_ptr;
           b_m.reinit(face);
           b_p.reinit(face);
-          b_m.gather_evaluate(in, EvaluationFlags::values);
-          b_p.gather_evaluate(in, EvaluationFlags::values);
+          // a side whose cell is not marked holds B = I and takes nothing
+          const VA   active_m = b_m.read_cell_data(b_active);
+          const VA   active_p = b_p.read_cell_data(b_active);
+          const bool inside = any_lane(active_m), outside = any_lane(active_p);
+          if (!inside && !outside)
+            continue;
+          if (inside)
+            b_m.gather_evaluate(in, EvaluationFlags::values);
+          if (outside)
+            b_p.gather_evaluate(in, EvaluationFlags::values);
           for (const unsigned int q : b_m.quadrature_point_indices())
             {
-              const VA   un   = u.get_value(q) * b_m.get_normal_vector(q);
-              const auto flux = upwind(un, b_m.get_value(q), b_p.get_value(q));
-              b_m.submit_value(-flux, q);
-              b_p.submit_value(flux, q);
+              const VA   un  = u.get_value(q) * b_m.get_normal_vector(q);
+              const auto b_q = [&](const auto &b, const bool any, const VA &active) {
+                return any ? b.get_value(q) * active + identity * (1. - active) : identity;
+              };
+              const auto flux =
+                upwind(un, b_q(b_m, inside, active_m), b_q(b_p, outside, active_p));
+              if (inside)
+                b_m.submit_value(-flux * active_m, q);
+              if (outside)
+                b_p.submit_value(flux * active_p, q);
             }
-          b_m.integrate_scatter(EvaluationFlags::values, out);
-          b_p.integrate_scatter(EvaluationFlags::values, out);
+          if (inside)
+            b_m.integrate_scatter(EvaluationFlags::values, out);
+          if (outside)
+            b_p.integrate_scatter(EvaluationFlags::values, out);
         }
     };
 
@@ -770,9 +868,6 @@ namespace Suspension::Solid
       std::unique_ptr<FaceB> b_ptr;
       if (with_B)
         b_ptr = std::make_unique<FaceB>(mf, range, true, 0, 0, 1);
-      Tensor<1, n_B, VA> identity;
-      for (unsigned int d = 0; d < dim; ++d)
-        identity[d] = 1.; // unrolled order starts with the diagonal
       for (unsigned int face = range.first; face < range.second; ++face)
         {
           u.reinit(face);
@@ -801,11 +896,14 @@ namespace Suspension::Solid
             continue;
           auto &b = *b_ptr;
           b.reinit(face);
+          const VA active = b.read_cell_data(b_active);
+          if (!any_lane(active))
+            continue;
           b.gather_evaluate(in, EvaluationFlags::values);
           for (const unsigned int q : b.quadrature_point_indices())
             {
               const VA un = u.get_value(q) * b.get_normal_vector(q);
-              b.submit_value(-upwind(un, b.get_value(q), identity), q);
+              b.submit_value(-upwind(un, b.get_value(q), identity) * active, q);
             }
           b.integrate_scatter(EvaluationFlags::values, out);
         }
@@ -835,7 +933,7 @@ namespace Suspension::Solid
             phi.read_dof_values(in);
             inverse_phi.apply(phi.begin_dof_values(), phi.begin_dof_values());
             phi.set_dof_values(out);
-            if (!with_B)
+            if (!with_B || !any_lane(b_active[cell]))
               continue;
             auto &b = *b_ptr;
             b.reinit(cell);
@@ -962,6 +1060,11 @@ namespace Suspension::Solid
     };
     for (unsigned int cell = 0; cell < matrix_free.n_cell_batches(); ++cell)
       {
+        bool marked = false; // elsewhere B = I
+        for (unsigned int v = 0; v < VA::size(); ++v)
+          marked = marked || b_active[cell][v] > 0.;
+        if (!marked)
+          continue;
         b.reinit(cell);
         b.read_dof_values(solution);
         b.evaluate(EvaluationFlags::values);

@@ -67,6 +67,7 @@ rm a_file
 expect set_unknown_entry  "$dir/valid.prm" --set Material/Viscosityy=1 -- "Material/Viscosityy"
 expect set_out_of_range   "$dir/valid.prm" --set Material/Density=-2 -- "Material/Density" "-2"
 expect set_no_value       "$dir/valid.prm" --set Material/Viscosity -- "Material/Viscosity" "Section/Entry=value"
+expect too_much_memory    "$dir/too_much_memory.prm" -- "too_much_memory.prm" "Mesh/Global refinements" "1.07e+09 cells" "kB per cell" "available" "more nodes"
 expect set_dimension      "$dir/valid.prm" --set Dimension=4 -- "Dimension" "4"
 expect directory_as_file  "$dir"                       -- "input_errors" "is a directory"
 

@@ -184,6 +184,7 @@ namespace Suspension::Parameters
     ConvectionForm convection      = ConvectionForm::skew_symmetric;
     double         solver_tolerance = 1e-10;
     bool           jacobi_momentum  = false; // else BoomerAMG
+    bool           matrix_free_momentum = true; // else assembled M, K, A
 
     static void declare(ParameterHandler &prm, unsigned int dim);
     void        parse(ParameterHandler &prm, unsigned int dim);

@@ -5,6 +5,7 @@
 #include <deal.II/lac/petsc_solver.h>
 
 #include <suspension/fluid/fluid_space.h>
+#include <suspension/fluid/momentum_operator.h>
 
 #include <memory>
 
@@ -62,6 +63,10 @@ namespace Suspension::Fluid
     double     momentum_alpha_over_dt = -1., momentum_nu = -1.;
     /// Jacobi instead of BoomerAMG for A (no set-up cost).
     bool jacobi_momentum = false;
+    /// A applied matrix-free (M, K and A are then not assembled; CG with
+    /// the Jacobi preconditioner of its matrix-free diagonal).
+    bool matrix_free_momentum = false;
+    MomentumOperator<dim> momentum_operator;
 
   private:
     MPI_Comm                                             communicator;

@@ -88,7 +88,10 @@ namespace Suspension::Solid
     Tensor<1, dim> velocity;
     double         taylor_deformation = 0.; // (L - S) / (L + S)
     double         inclination        = 0.; // degrees, long axis against x
-    double         solid_area         = 0.; // measure of {phi >= 1/2}
+    double         solid_area         = 0.; // measure of {phi >= 1/2} at Gauss points
+    /// the same on sub-cells of the cells the level 1/2 crosses, and the
+    /// Taylor deformation of that region
+    double         solid_area_subcell = 0., taylor_deformation_half = 0., inclination_half = 0.;
     /// the same from the moments of phi itself (tail included)
     double         taylor_deformation_phi = 0., inclination_phi = 0.;
     /// the stretch of the material, from the mean of B where H(phi) = 1:

@@ -102,6 +102,17 @@ namespace Suspension::Solid
 
     const MatrixFree<dim, double> &get_matrix_free() const { return matrix_free; }
 
+    /// Where B is transported: B = I wherever a cell and its face
+    /// neighbours hold no solid (every node of phi at most 1e-8), since
+    /// reset_B_in_fluid() would put it back to I there anyway. Marks the
+    /// cells that hold solid (phi > 1e-8 at a node) and their face
+    /// neighbours, the same on every rank (ghost cells take their owner's
+    /// mark); apply() and limit_B() then skip B elsewhere, and a face to an
+    /// unmarked cell sees B = I outside, as an inflow boundary does. Until
+    /// it is called, every cell is marked. Returns the number of marked
+    /// cells of this rank.
+    unsigned int mark_solid_cells(const VectorType &solution);
+
     /// Interface compression: phi also moves with the flux
     /// c |u| phi (1 - phi) grad phi / |grad phi| (towards the solid, only
     /// where 0 < phi < 1), with a Lax-Friedrichs face flux; 0: off.
@@ -189,6 +200,11 @@ namespace Suspension::Solid
     mutable std::vector<double>         vertex_mean, vertex_weight;
     mutable std::vector<double>         cell_mean;
     mutable AlignedVector<Lanes>        reconstruction;
+    /// 1 in the lanes of cells where B is transported, 0 elsewhere; owned
+    /// and ghost cell batches (mark_solid_cells)
+    AlignedVector<VectorizedArray<double>> b_active;
+    /// active_cell_index() of each lane of the owned and ghost cell batches
+    std::vector<unsigned int> lane_cell_index;
     mutable VectorType           ghosted, ghosted_curvature;
     /// volume-weighted sums of the cells' unit normals at the vertices,
     /// for div n

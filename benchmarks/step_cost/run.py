@@ -1,0 +1,183 @@
+#!/usr/bin/env python3
+"""The cost of a step, old code against new, side by side in one run
+(issue 14).
+
+Usage (from the repository root):
+
+    python3 benchmarks/step_cost/run.py [--old REV] [--scenes a,b,...] [--replot]
+
+Builds REV (default: 958feed, the end of session 10, before issue 14's
+work) in a git worktree under work/old, copies build/suspension (the
+working tree, not rebuilt here) to work/new, and runs each scene with both,
+one after the other, never two at once. Prints per scene the wall time,
+the TimerOutput sections that matter, the peak resident memory and the
+ratios new/old, and writes results.csv and step_cost.png next to this
+script. --replot redraws the chart and reprints the table from results.csv.
+"""
+
+import argparse
+import csv
+import os
+import re
+import shutil
+import subprocess
+import sys
+import time
+
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.abspath(__file__)), "..", "..", "scripts"))
+from benchmark_tools import plt, REPO  # noqa: E402
+
+HERE = os.path.dirname(os.path.abspath(__file__))
+WORK = os.path.join(HERE, "work")
+MPI_ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
+               OMP_NUM_THREADS="1")
+
+P = os.path.join(REPO, "parameters")
+# name: (ranks, parameter file, --set entries); every run writes no fields
+SCENES = {
+    "main job to t = 0.1 (2D, 2 ranks)": (
+        2, os.path.join(P, "suspension_channel_2d.prm"),
+        ["Time stepping/End time=0.1"]),
+    "3D reduced box, 6 steps (level 3, 2 ranks)": (
+        2, os.path.join(P, "suspension_channel_3d_reduced.prm"),
+        ["Time stepping/Maximum number of steps=6", "Statistics/Enabled=false"]),
+    "cavity disc to t = 1 (32 cells per diameter, 1 rank)": (
+        1, os.path.join(P, "disc_cavity_2d.prm"),
+        ["Time stepping/End time=1", "Output/Write phi cells=false"]),
+}
+SECTIONS = ["solid transport", "fluid: momentum right-hand side", "fluid: momentum solve",
+            "fluid: projection", "mesh adaptation", "setup (mesh, DoFs, matrices)"]
+
+
+def sh(cmd, **kw):
+    return subprocess.run(cmd, check=True, **kw)
+
+
+def build_old(rev):
+    """A worktree of `rev` with its own Release build (about 5 minutes)."""
+    tree = os.path.join(WORK, "old")
+    exe = os.path.join(tree, "build", "suspension")
+    if os.path.exists(exe):
+        have = subprocess.run(["git", "-C", tree, "rev-parse", "HEAD"], capture_output=True,
+                              text=True).stdout.strip()
+        want = subprocess.run(["git", "-C", REPO, "rev-parse", rev], capture_output=True,
+                              text=True).stdout.strip()
+        if have == want:
+            return exe
+    if os.path.exists(tree):
+        sh(["git", "-C", REPO, "worktree", "remove", "--force", tree])
+    sh(["git", "-C", REPO, "worktree", "add", "--detach", tree, rev])
+    sh(["cmake", "-S", tree, "-B", os.path.join(tree, "build"), "-DCMAKE_BUILD_TYPE=Release"],
+       stdout=subprocess.DEVNULL)
+    sh(["cmake", "--build", os.path.join(tree, "build"), "-j", str(os.cpu_count() or 1)],
+       stdout=subprocess.DEVNULL)
+    return exe
+
+
+def copy_new():
+    """build/suspension and its library, so that a rebuild meanwhile does not
+    change what is measured."""
+    target = os.path.join(WORK, "new")
+    os.makedirs(target, exist_ok=True)
+    for name in os.listdir(os.path.join(REPO, "build")):
+        if name == "suspension" or name.startswith("libsuspension"):
+            shutil.copy2(os.path.join(REPO, "build", name), target)
+    return os.path.join(target, "suspension")
+
+
+def run(exe, name, ranks, prm, sets, label):
+    out = os.path.join(WORK, "runs", label + "_" + re.sub(r"[^a-z0-9]+", "_", name.lower()))
+    os.makedirs(out, exist_ok=True)
+    args = [exe, prm, "--set", "Output/Directory=" + os.path.join(out, "output"),
+            "--set", "Output/Write vtu=false", "--set", "Output/Timer summary=true",
+            "--set", "Output/Progress interval=0"]
+    for s in sets:
+        args += ["--set", s]
+    cmd = (["mpirun", "-np", str(ranks)] if ranks > 1 else []) + args
+    # the peak resident memory of the largest rank (GNU time: max over the
+    # waited-for processes)
+    start = time.perf_counter()
+    with open(os.path.join(out, "log"), "w") as log:
+        sh(["/usr/bin/time", "-f", "%M", "-o", os.path.join(out, "rss")] + cmd,
+           stdout=log, stderr=subprocess.STDOUT, env=MPI_ENV, cwd=out)
+    wall = time.perf_counter() - start
+    text = open(os.path.join(out, "log")).read()
+    row = {"scene": name, "code": label, "ranks": ranks, "wall_s": round(wall, 2),
+           "peak_MB": round(int(open(os.path.join(out, "rss")).read().split()[-1]) * 1.024e-3, 1)}
+    m = re.search(r"(\d+) cells, (\d+) velocity", text)
+    row["cells"], row["velocity_dofs"] = (int(m.group(1)), int(m.group(2))) if m else ("", "")
+    m = re.search(r"Total wallclock time elapsed since start\s*\|\s*([0-9.e+]+)s", text)
+    row["solver_s"] = float(m.group(1)) if m else ""
+    for section in SECTIONS:
+        m = re.search(r"\|\s*" + re.escape(section) + r"\s*\|\s*(\d+)\s*\|\s*([0-9.e+]+)s", text)
+        row[section] = float(m.group(2)) if m else 0.
+    m = re.search(r"mu_eff/mu = ([0-9.]+ \+- [0-9.]+)", text)
+    row["mu_eff"] = m.group(1) if m else ""
+    return row
+
+
+def table(rows):
+    by = {(r["scene"], r["code"]): r for r in rows}
+    print(f"{'scene':52s} {'':5s} {'wall s':>8s} {'solver s':>9s} {'transport':>9s} "
+          f"{'peak MB':>8s}")
+    for scene in dict.fromkeys(r["scene"] for r in rows):
+        for code in ("old", "new"):
+            r = by.get((scene, code))
+            if r:
+                print(f"{scene:52s} {code:5s} {float(r['wall_s']):8.1f} {float(r['solver_s'] or 0):9.1f} "
+                      f"{float(r['solid transport']):9.1f} {float(r['peak_MB']):8.0f}")
+        if (scene, "old") in by and (scene, "new") in by:
+            o, n = by[(scene, "old")], by[(scene, "new")]
+            ratio = lambda k: float(n[k]) / float(o[k]) if float(o[k] or 0) > 0 else float("nan")
+            print(f"{'':52s} {'ratio':5s} {ratio('wall_s'):8.2f} {ratio('solver_s'):9.2f} "
+                  f"{ratio('solid transport'):9.2f} {ratio('peak_MB'):8.2f}")
+
+
+def chart(rows):
+    scenes = list(dict.fromkeys(r["scene"] for r in rows))
+    by = {(r["scene"], r["code"]): r for r in rows}
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4))
+    for ax, key, title in ((axes[0], "solver_s", "solver wall time (s)"),
+                           (axes[1], "peak_MB", "peak resident memory (MB)")):
+        for i, code in enumerate(("old", "new")):
+            values = [float(by[(s, code)][key] or 0) if (s, code) in by else 0 for s in scenes]
+            ax.barh([j + 0.4 * i for j in range(len(scenes))], values, height=0.4,
+                    label=code, color=("0.6", "C0")[i])
+        ax.set_yticks([j + 0.2 for j in range(len(scenes))])
+        ax.set_yticklabels([s.replace(" (", "\n(") for s in scenes], fontsize=8)
+        ax.set_title(title)
+        ax.legend()
+    fig.tight_layout()
+    fig.savefig(os.path.join(HERE, "step_cost.png"), dpi=110)
+
+
+def main():
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--old", default="958feed")
+    parser.add_argument("--scenes", default="")
+    parser.add_argument("--replot", action="store_true")
+    a = parser.parse_args()
+    csv_path = os.path.join(HERE, "results.csv")
+    if a.replot:
+        rows = list(csv.DictReader(open(csv_path)))
+    else:
+        os.makedirs(WORK, exist_ok=True)
+        exes = {"old": build_old(a.old), "new": copy_new()}
+        chosen = [s for s in SCENES if not a.scenes or any(k in s for k in a.scenes.split(","))]
+        rows = []
+        for name in chosen:
+            ranks, prm, sets = SCENES[name]
+            for label in ("old", "new"):
+                rows.append(run(exes[label], name, ranks, prm, sets, label))
+                print(f"  {name} [{label}]: {rows[-1]['wall_s']} s", flush=True)
+        fields = list(rows[0].keys())
+        with open(csv_path, "w", newline="") as f:
+            w = csv.DictWriter(f, fieldnames=fields)
+            w.writeheader()
+            w.writerows(rows)
+    table(rows)
+    chart(rows)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,40 @@
+#pragma once
+
+#include <suspension/core/parameters.h>
+
+#include <mpi.h>
+
+#include <string>
+
+namespace Suspension
+{
+  /// What a mesh will cost in memory, from the number of cells (issue 14,
+  /// item 4).
+  struct MemoryEstimate
+  {
+    double cells          = 0.; // of the initial mesh (before adaptation)
+    double bytes_per_cell = 0.; // measured, see memory.cc
+    double bytes_per_rank = 0.; // the mesh's share of one rank, plus the base
+    double available_per_rank = 0.; // MemAvailable of the node / its ranks
+    unsigned int ranks_on_node = 1;
+  };
+
+  /// The estimate for the scene's initial mesh (base cells times
+  /// 2^(dim global refinements), the refinement region not counted) on the
+  /// ranks of `communicator`.
+  MemoryEstimate estimate_memory(const Parameters::All &parameters, MPI_Comm communicator);
+
+  /// Throws an InputError of 'Mesh/Global refinements' when the estimate
+  /// does not fit in the memory available to the ranks of a node: a run
+  /// that would be killed by the system after its set-up stops at once,
+  /// before anything is written.
+  void check_memory(const Parameters::All &parameters, MPI_Comm communicator);
+
+  /// Peak resident memory (VmHWM) of this process, in bytes.
+  double peak_resident_memory();
+
+  /// "Memory: peak resident 767 MB per rank (largest of 2 ranks), 2.4 kB
+  /// per velocity DoF; estimated 690 MB" (collective).
+  std::string memory_line(double velocity_dofs, double estimated_bytes_per_rank,
+                          MPI_Comm communicator);
+} // namespace Suspension

@@ -1,0 +1,61 @@
+#pragma once
+
+#include <deal.II/lac/diagonal_matrix.h>
+#include <deal.II/lac/la_parallel_vector.h>
+#include <deal.II/matrix_free/matrix_free.h>
+
+#include <deal.II/lac/generic_linear_algebra.h>
+
+#include <suspension/fluid/fluid_space.h>
+
+namespace Suspension::Fluid
+{
+  /**
+   * The momentum predictor's operator A = (alpha/dt) M + nu K without an
+   * assembled matrix (issue 14, item 1): applied cell by cell with
+   * FEEvaluation (sum factorisation), the hanging-node, periodic and
+   * Dirichlet constraints of the velocity resolved on the fly; CG with the
+   * Jacobi preconditioner of its diagonal, computed matrix-free. A change of
+   * dt costs one diagonal (one pass over the cells); a mesh change only the
+   * MatrixFree data. The vectors of the rest of the fluid stay PETSc's: a
+   * solve copies the right-hand side in and the solution out (locally
+   * owned entries; the same DoF numbering).
+   */
+  using VectorType = LinearAlgebraPETSc::MPI::Vector;
+
+  template <int dim>
+  class MomentumOperator
+  {
+  public:
+    using Vector = LinearAlgebra::distributed::Vector<double>;
+
+    /// After every mesh change (the space rebuilt).
+    void reinit(const FluidSpace<dim> &space);
+
+    /// The coefficients (alpha/dt, nu); recomputes the diagonal when they
+    /// change.
+    void set_coefficients(double mass, double viscosity);
+
+    /// dst = A src on the unconstrained DoFs; constrained ones copied.
+    void vmult(Vector &dst, const Vector &src) const;
+
+    /// Solves A x = b to `tolerance` relative to |b| with the constrained
+    /// entries of b and of the initial guess x set to zero (the caller
+    /// distributes the constraints afterwards, as for the assembled A).
+    /// Returns the CG iterations.
+    unsigned int solve(VectorType &x, const VectorType &b, double tolerance) const;
+
+  private:
+    template <int degree, int n_q>
+    void apply_cells(Vector &dst, const Vector &src) const;
+    template <int degree, int n_q>
+    void compute_diagonal();
+
+    MatrixFree<dim, double> matrix_free;
+    unsigned int            degree = 2;
+    double                  mass = -1., viscosity = -1.;
+    DiagonalMatrix<Vector>  inverse_diagonal;
+    std::vector<unsigned int> constrained; // local indices, all constrained DoFs
+    mutable Vector          x_local, b_local;
+  };
+} // namespace Suspension::Fluid

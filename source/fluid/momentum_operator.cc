@@ -1,0 +1,137 @@
+#include <deal.II/base/mpi.h>
+#include <deal.II/fe/mapping_q1.h>
+#include <deal.II/lac/read_write_vector.h>
+#include <deal.II/lac/solver_cg.h>
+#include <deal.II/lac/solver_control.h>
+#include <deal.II/matrix_free/fe_evaluation.h>
+#include <deal.II/matrix_free/tools.h>
+
+#include <suspension/fluid/momentum_operator.h>
+
+namespace Suspension::Fluid
+{
+  template <int dim>
+  void MomentumOperator<dim>::reinit(const FluidSpace<dim> &space)
+  {
+    degree = space.fe_velocity.degree;
+    typename MatrixFree<dim, double>::AdditionalData data;
+    data.tasks_parallel_scheme = MatrixFree<dim, double>::AdditionalData::none;
+    data.mapping_update_flags  = update_values | update_gradients | update_JxW_values;
+    matrix_free.reinit(MappingQ1<dim>(), space.dof_velocity, space.velocity_constraints,
+                       QGauss<1>(degree + 1), data);
+    matrix_free.initialize_dof_vector(x_local);
+    matrix_free.initialize_dof_vector(b_local);
+    // every constrained DoF (Dirichlet, hanging, periodic) is left out of
+    // the system and filled in by the caller's distribute()
+    constrained.clear();
+    const auto &owned = x_local.get_partitioner()->locally_owned_range();
+    for (unsigned int i = 0; i < owned.n_elements(); ++i)
+      if (space.velocity_constraints.is_constrained(owned.nth_index_in_set(i)))
+        constrained.push_back(i);
+    mass = viscosity = -1.;
+  }
+
+  template <int dim>
+  template <int fe_degree, int n_q>
+  void MomentumOperator<dim>::apply_cells(Vector &dst, const Vector &src) const
+  {
+    matrix_free.template cell_loop<Vector, Vector>(
+      [this](const MatrixFree<dim, double> &mf, Vector &out, const Vector &in,
+             const std::pair<unsigned int, unsigned int> &range) {
+        FEEvaluation<dim, fe_degree, n_q, dim, double> u(mf);
+        for (unsigned int cell = range.first; cell < range.second; ++cell)
+          {
+            u.reinit(cell);
+            u.gather_evaluate(in, EvaluationFlags::values | EvaluationFlags::gradients);
+            for (const unsigned int q : u.quadrature_point_indices())
+              {
+                u.submit_value(mass * u.get_value(q), q);
+                u.submit_gradient(viscosity * u.get_gradient(q), q);
+              }
+            u.integrate_scatter(EvaluationFlags::values | EvaluationFlags::gradients, out);
+          }
+      },
+      dst, src, true);
+  }
+
+  template <int dim>
+  void MomentumOperator<dim>::vmult(Vector &dst, const Vector &src) const
+  {
+    if (degree == 2)
+      apply_cells<2, 3>(dst, src);
+    else
+      apply_cells<-1, 0>(dst, src);
+    for (const unsigned int i : constrained)
+      dst.local_element(i) = src.local_element(i);
+  }
+
+  template <int dim>
+  template <int fe_degree, int n_q>
+  void MomentumOperator<dim>::compute_diagonal()
+  {
+    Vector &diagonal = inverse_diagonal.get_vector();
+    matrix_free.initialize_dof_vector(diagonal);
+    MatrixFreeTools::compute_diagonal<dim, fe_degree, n_q, dim, double, VectorizedArray<double>>(
+      matrix_free, diagonal, [this](FEEvaluation<dim, fe_degree, n_q, dim, double> &u) {
+        u.evaluate(EvaluationFlags::values | EvaluationFlags::gradients);
+        for (const unsigned int q : u.quadrature_point_indices())
+          {
+            u.submit_value(mass * u.get_value(q), q);
+            u.submit_gradient(viscosity * u.get_gradient(q), q);
+          }
+        u.integrate(EvaluationFlags::values | EvaluationFlags::gradients);
+      });
+    for (const unsigned int i : constrained)
+      diagonal.local_element(i) = 1.;
+    for (auto &d : diagonal)
+      d = d > 0. ? 1. / d : 1.;
+  }
+
+  template <int dim>
+  void MomentumOperator<dim>::set_coefficients(const double mass_, const double viscosity_)
+  {
+    if (mass_ == mass && viscosity_ == viscosity)
+      return;
+    mass      = mass_;
+    viscosity = viscosity_;
+    if (degree == 2)
+      compute_diagonal<2, 3>();
+    else
+      compute_diagonal<-1, 0>();
+  }
+
+  template <int dim>
+  unsigned int MomentumOperator<dim>::solve(VectorType &x, const VectorType &b,
+                                            const double tolerance) const
+  {
+    // in: the locally owned entries (both vectors number the DoFs alike)
+    const auto &owned = x_local.get_partitioner()->locally_owned_range();
+    LinearAlgebra::ReadWriteVector<double> buffer(owned);
+    buffer.import(b, VectorOperation::insert);
+    b_local.import(buffer, VectorOperation::insert);
+    buffer.import(x, VectorOperation::insert);
+    x_local.import(buffer, VectorOperation::insert);
+    for (const unsigned int i : constrained)
+      b_local.local_element(i) = x_local.local_element(i) = 0.;
+
+    const double norm = b_local.l2_norm();
+    unsigned int iterations = 0;
+    if (norm == 0.)
+      x_local = 0.;
+    else
+      {
+        SolverControl    control(5000, tolerance * norm);
+        SolverCG<Vector> cg(control);
+        cg.solve(*this, x_local, b_local, inverse_diagonal);
+        iterations = control.last_step();
+      }
+    // out
+    for (unsigned int i = 0; i < owned.n_elements(); ++i)
+      x(owned.nth_index_in_set(i)) = x_local.local_element(i);
+    x.compress(VectorOperation::insert);
+    return iterations;
+  }
+
+  template class MomentumOperator<2>;
+  template class MomentumOperator<3>;
+} // namespace Suspension::Fluid
