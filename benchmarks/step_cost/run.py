@@ -35,9 +35,8 @@ MPI_ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CO
 P = os.path.join(REPO, "parameters")
 # name: (ranks, parameter file, --set entries); every run writes no fields
 SCENES = {
-    "main job to t = 0.1 (2D, 2 ranks)": (
-        2, os.path.join(P, "suspension_channel_2d.prm"),
-        ["Time stepping/End time=0.1"]),
+    "main job (2D, 2 ranks)": (
+        2, os.path.join(P, "suspension_channel_2d.prm"), []),
     "3D reduced box, 6 steps (level 3, 2 ranks)": (
         2, os.path.join(P, "suspension_channel_3d_reduced.prm"),
         ["Time stepping/Maximum number of steps=6", "Statistics/Enabled=false"]),
@@ -111,8 +110,8 @@ def run(exe, name, ranks, prm, sets, label):
     for section in SECTIONS:
         m = re.search(r"\|\s*" + re.escape(section) + r"\s*\|\s*(\d+)\s*\|\s*([0-9.e+]+)s", text)
         row[section] = float(m.group(2)) if m else 0.
-    m = re.search(r"mu_eff/mu = ([0-9.]+ \+- [0-9.]+)", text)
-    row["mu_eff"] = m.group(1) if m else ""
+    m = re.search(r"mu_eff/mu = ([-0-9.]+ \+- [0-9.]+), N1 = ([-0-9.]+ \+- [0-9.]+), N2 = ([-0-9.]+ \+- [0-9.]+)", text)
+    row["mu_eff"], row["N1"], row["N2"] = m.groups() if m else ("", "", "")
     return row
 
 
@@ -125,7 +124,8 @@ def table(rows):
             r = by.get((scene, code))
             if r:
                 print(f"{scene:52s} {code:5s} {float(r['wall_s']):8.1f} {float(r['solver_s'] or 0):9.1f} "
-                      f"{float(r['solid transport']):9.1f} {float(r['peak_MB']):8.0f}")
+                      f"{float(r['solid transport']):9.1f} {float(r['peak_MB']):8.0f}"
+                      + (f"  mu_eff {r['mu_eff']}, N1 {r['N1']}, N2 {r['N2']}" if r.get("mu_eff") else ""))
         if (scene, "old") in by and (scene, "new") in by:
             o, n = by[(scene, "old")], by[(scene, "new")]
             ratio = lambda k: float(n[k]) / float(o[k]) if float(o[k] or 0) > 0 else float("nan")
