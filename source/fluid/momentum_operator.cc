@@ -1,12 +1,15 @@
 #include <deal.II/base/mpi.h>
 #include <deal.II/fe/mapping_q1.h>
-#include <deal.II/lac/read_write_vector.h>
 #include <deal.II/lac/solver_cg.h>
 #include <deal.II/lac/solver_control.h>
 #include <deal.II/matrix_free/fe_evaluation.h>
 #include <deal.II/matrix_free/tools.h>
 
 #include <suspension/fluid/momentum_operator.h>
+
+#include <petscvec.h>
+
+#include <algorithm>
 
 namespace Suspension::Fluid
 {
@@ -104,13 +107,17 @@ namespace Suspension::Fluid
   unsigned int MomentumOperator<dim>::solve(VectorType &x, const VectorType &b,
                                             const double tolerance) const
   {
-    // in: the locally owned entries (both vectors number the DoFs alike)
-    const auto &owned = x_local.get_partitioner()->locally_owned_range();
-    LinearAlgebra::ReadWriteVector<double> buffer(owned);
-    buffer.import(b, VectorOperation::insert);
-    b_local.import(buffer, VectorOperation::insert);
-    buffer.import(x, VectorOperation::insert);
-    x_local.import(buffer, VectorOperation::insert);
+    // in: the locally owned entries, contiguous and in the same order in
+    // both kinds of vector (the DoFHandler's locally owned range)
+    const auto copy_in = [](const VectorType &from, Vector &to) {
+      const PetscScalar *values;
+      AssertThrow(VecGetArrayRead(from, &values) == 0, ExcMessage("VecGetArrayRead"));
+      std::copy(values, values + to.locally_owned_size(), to.begin());
+      AssertThrow(VecRestoreArrayRead(from, &values) == 0, ExcMessage("VecRestoreArrayRead"));
+    };
+    AssertDimension(b.locally_owned_size(), b_local.locally_owned_size());
+    copy_in(b, b_local);
+    copy_in(x, x_local);
     for (const unsigned int i : constrained)
       b_local.local_element(i) = x_local.local_element(i) = 0.;
 
@@ -126,9 +133,10 @@ namespace Suspension::Fluid
         iterations = control.last_step();
       }
     // out
-    for (unsigned int i = 0; i < owned.n_elements(); ++i)
-      x(owned.nth_index_in_set(i)) = x_local.local_element(i);
-    x.compress(VectorOperation::insert);
+    PetscScalar *values;
+    AssertThrow(VecGetArray(x, &values) == 0, ExcMessage("VecGetArray"));
+    std::copy(x_local.begin(), x_local.begin() + x_local.locally_owned_size(), values);
+    AssertThrow(VecRestoreArray(x, &values) == 0, ExcMessage("VecRestoreArray"));
     return iterations;
   }
 
