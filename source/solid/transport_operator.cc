@@ -11,7 +11,6 @@
 #include <suspension/solid/transport_operator.h>
 
 #include <algorithm>
-#include <cstdlib>
 #include <numeric>
 #include <sstream>
 #include <functional>
@@ -86,6 +85,15 @@ namespace Suspension::Solid
             out[v] += r.weight * (0.5 * (1. + std::tanh(argument)) - dg_value[v]);
           }
       return out;
+    }
+
+    // whether some lane of a batch is marked (B transported there)
+    bool any_lane(const VA &active)
+    {
+      for (unsigned int v = 0; v < VA::size(); ++v)
+        if (active[v] > 0.)
+          return true;
+      return false;
     }
 
     // upwind flux of a transported quantity: un > 0 takes the inside value
@@ -611,10 +619,10 @@ namespace Suspension::Solid
   }
 
   template <int dim>
-  unsigned int TransportOperator<dim>::mark_solid_cells(const VectorType &solution)
+  void TransportOperator<dim>::mark_solid_cells(const VectorType &solution)
   {
     if (!with_B)
-      return 0;
+      return;
     constexpr double   threshold = 1e-8;
     const unsigned int n_lanes   = VectorizedArray<double>::size();
     const auto        &tria      = matrix_free.get_dof_handler(0).get_triangulation();
@@ -656,16 +664,12 @@ namespace Suspension::Solid
           }
       }
     exchange(marked);
-    unsigned int n_marked = 0;
     for (unsigned int cell = 0; cell < b_active.size(); ++cell)
       for (unsigned int v = 0; v < n_lanes; ++v)
         {
           const unsigned int index = lane_cell_index[cell * n_lanes + v];
           b_active[cell][v] = (index != numbers::invalid_unsigned_int && marked[index]) ? 1. : 0.;
-          if (cell < matrix_free.n_cell_batches() && b_active[cell][v] > 0.)
-            ++n_marked;
         }
-    return n_marked;
   }
 
   template <int dim>
@@ -679,12 +683,6 @@ namespace Suspension::Solid
       std::function<void(const MatrixFree<dim, double> &, VectorType &, const VectorType &, const Range &)>;
     const bool compress         = compression > 0.;
     // B only in the cells mark_solid_cells() marked; I outside
-    const auto any_lane = [](const VA &active) {
-      for (unsigned int v = 0; v < VA::size(); ++v)
-        if (active[v] > 0.)
-          return true;
-      return false;
-    };
     Tensor<1, n_B, VA> identity;
     for (unsigned int d = 0; d < dim; ++d)
       identity[d] = 1.; // unrolled order starts with the diagonal
@@ -1060,10 +1058,7 @@ namespace Suspension::Solid
     };
     for (unsigned int cell = 0; cell < matrix_free.n_cell_batches(); ++cell)
       {
-        bool marked = false; // elsewhere B = I
-        for (unsigned int v = 0; v < VA::size(); ++v)
-          marked = marked || b_active[cell][v] > 0.;
-        if (!marked)
+        if (!any_lane(b_active[cell])) // elsewhere B = I
           continue;
         b.reinit(cell);
         b.read_dof_values(solution);

@@ -109,9 +109,8 @@ namespace Suspension::Solid
     /// neighbours, the same on every rank (ghost cells take their owner's
     /// mark); apply() and limit_B() then skip B elsewhere, and a face to an
     /// unmarked cell sees B = I outside, as an inflow boundary does. Until
-    /// it is called, every cell is marked. Returns the number of marked
-    /// cells of this rank.
-    unsigned int mark_solid_cells(const VectorType &solution);
+    /// it is called, every cell is marked.
+    void mark_solid_cells(const VectorType &solution);
 
     /// Interface compression: phi also moves with the flux
     /// c |u| phi (1 - phi) grad phi / |grad phi| (towards the solid, only
