@@ -145,6 +145,17 @@ namespace Suspension::Solid
         lane_cell_index[cell * VectorizedArray<double>::size() + v] =
           matrix_free.get_cell_iterator(cell, v)->active_cell_index();
 
+    // the periodic faces among the inner faces (a cell's face on the
+    // domain's boundary that has a neighbour across it)
+    periodic_face_lane.assign(matrix_free.n_inner_face_batches() * VectorizedArray<double>::size(), 0);
+    for (unsigned int face = 0; face < matrix_free.n_inner_face_batches(); ++face)
+      for (unsigned int v = 0; v < matrix_free.n_active_entries_per_face_batch(face); ++v)
+        {
+          const auto [cell, face_no] = matrix_free.get_face_iterator(face, v, true);
+          periodic_face_lane[face * VectorizedArray<double>::size() + v] = cell->at_boundary(face_no);
+        }
+    matrix_free.initialize_dof_vector(face_scratch, 0);
+
     // cell sizes for the interface diffusion: a cell's smallest vertex
     // distance, a face's the smaller of its two cells'
     cell_size.resize(matrix_free.n_cell_batches());
@@ -604,6 +615,50 @@ namespace Suspension::Solid
         phi.set_dof_values_plain(solution);
       }
     return true;
+  }
+
+  template <int dim>
+  double TransportOperator<dim>::face_jumps(const VectorType &solution, const double touches) const
+  {
+    face_scratch.copy_locally_owned_data_from(solution);
+    face_scratch.update_ghost_values();
+    // quadrature 1: k + 1 Gauss points
+    FEFaceEvaluation<dim, -1, 0, 1, double> phi_m(matrix_free, true, 0, 1, 0);
+    FEFaceEvaluation<dim, -1, 0, 1, double> phi_p(matrix_free, false, 0, 1, 0);
+    const unsigned int n_lanes = VA::size();
+    const auto touching = [&](const auto &phi, const unsigned int v) {
+      for (unsigned int i = 0; i < phi.dofs_per_cell; ++i)
+        if (phi.begin_dof_values()[i][v] > touches)
+          return true;
+      return false;
+    };
+    double total = 0.;
+    for (unsigned int face = 0; face < matrix_free.n_inner_face_batches(); ++face)
+      {
+        phi_m.reinit(face);
+        phi_p.reinit(face);
+        // the whole cells' values: the touch test reads every node
+        phi_m.read_dof_values(face_scratch);
+        phi_p.read_dof_values(face_scratch);
+        bool any = false;
+        std::array<bool, VA::size()> counts{};
+        for (unsigned int v = 0; v < matrix_free.n_active_entries_per_face_batch(face); ++v)
+          {
+            counts[v] = !periodic_face_lane[face * n_lanes + v] &&
+                        (touching(phi_m, v) || touching(phi_p, v));
+            any = any || counts[v];
+          }
+        if (!any)
+          continue;
+        phi_m.evaluate(EvaluationFlags::values);
+        phi_p.evaluate(EvaluationFlags::values);
+        for (unsigned int v = 0; v < n_lanes; ++v)
+          if (counts[v])
+            for (const unsigned int q : phi_m.quadrature_point_indices())
+              total += std::abs(phi_m.get_value(q)[v] - phi_p.get_value(q)[v]) * phi_m.JxW(q)[v];
+      }
+    face_scratch.zero_out_ghost_values();
+    return total;
   }
 
   template <int dim>

@@ -6,7 +6,6 @@
 #include <deal.II/distributed/solution_transfer.h>
 #include <deal.II/distributed/tria.h>
 #include <deal.II/dofs/dof_handler.h>
-#include <deal.II/fe/fe_interface_values.h>
 #include <deal.II/fe/fe_system.h>
 #include <deal.II/fe/fe_values.h>
 
@@ -214,10 +213,6 @@ namespace Suspension::Solid
 
   private:
     void reinit_discretization(const Fluid::FluidSpace<dim> &fluid_space);
-    /// int |[phi]| over the inner faces of `cell` (half where the neighbour
-    /// touches solid too, so that the sum over such cells counts each once)
-    double face_variation(const typename DoFHandler<dim>::active_cell_iterator &cell,
-                          FEInterfaceValues<dim> &interface_values) const;
     /// cells with phi above this at a node enter the interface measures
     static constexpr double touches_solid = 1e-3;
     void check_B(const SolidDiagnostics &d, double time) const;
@@ -251,8 +246,6 @@ namespace Suspension::Solid
     InterfaceSharpening<dim> sharpening;
     unsigned int           steps_since_sharpening = 0;
     VectorType             solution, stage, stage_rhs, u0, u1, u_stage;
-    /// solution with every DoF of the ghost cells, for face jumps
-    mutable VectorType     relevant_solution;
     double                 initial_volume = 0., time = 0.;
     /// int_0^t int_{boundary} (u.n) phi^ ds dt, summed over the RK stages
     /// with the weights of the scheme (SolidPhase::advance)

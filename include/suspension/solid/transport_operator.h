@@ -102,6 +102,15 @@ namespace Suspension::Solid
 
     const MatrixFree<dim, double> &get_matrix_free() const { return matrix_free; }
 
+    /// This rank's share of the jumps of phi across the faces between cells
+    /// (hanging faces included, periodic ones not): the sum of
+    /// int_face |phi^+ - phi^-| ds over the faces that have a cell on
+    /// either side with phi > `touches` at a node of the DG polynomial,
+    /// with k + 1 Gauss points per direction. MatrixFree gives each face to
+    /// one rank, so the sum over the ranks counts every face once. The
+    /// face part of the total variation of phi, for the interface width.
+    double face_jumps(const VectorType &solution, double touches) const;
+
     /// Where B is transported: B = I wherever a cell and its face
     /// neighbours hold no solid (every node of phi at most 1e-8), since
     /// reset_B_in_fluid() would put it back to I there anyway. Marks the
@@ -204,6 +213,10 @@ namespace Suspension::Solid
     AlignedVector<VectorizedArray<double>> b_active;
     /// active_cell_index() of each lane of the owned and ghost cell batches
     std::vector<unsigned int> lane_cell_index;
+    /// 1 in the lanes of inner face batches that are periodic faces
+    std::vector<unsigned char> periodic_face_lane;
+    /// solution with the ghost values of the face neighbours (face_jumps)
+    mutable VectorType face_scratch;
     mutable VectorType           ghosted, ghosted_curvature;
     /// volume-weighted sums of the cells' unit normals at the vertices,
     /// for div n
