@@ -32,6 +32,16 @@ namespace Suspension::Fluid
       if (space.velocity_constraints.is_constrained(owned.nth_index_in_set(i)))
         constrained.push_back(i);
     mass = viscosity = -1.;
+    if (degree == 2)
+      {
+        compute_diagonal<2, 3>(mass_diagonal, 1., 0.);
+        compute_diagonal<2, 3>(viscous_diagonal, 0., 1.);
+      }
+    else
+      {
+        compute_diagonal<-1, 0>(mass_diagonal, 1., 0.);
+        compute_diagonal<-1, 0>(viscous_diagonal, 0., 1.);
+      }
   }
 
   template <int dim>
@@ -70,12 +80,12 @@ namespace Suspension::Fluid
 
   template <int dim>
   template <int fe_degree, int n_q>
-  void MomentumOperator<dim>::compute_diagonal()
+  void MomentumOperator<dim>::compute_diagonal(Vector &diagonal, const double mass,
+                                              const double viscosity) const
   {
-    Vector &diagonal = inverse_diagonal.get_vector();
     matrix_free.initialize_dof_vector(diagonal);
     MatrixFreeTools::compute_diagonal<dim, fe_degree, n_q, dim, double, VectorizedArray<double>>(
-      matrix_free, diagonal, [this](FEEvaluation<dim, fe_degree, n_q, dim, double> &u) {
+      matrix_free, diagonal, [&](FEEvaluation<dim, fe_degree, n_q, dim, double> &u) {
         u.evaluate(EvaluationFlags::values | EvaluationFlags::gradients);
         for (const unsigned int q : u.quadrature_point_indices())
           {
@@ -84,10 +94,6 @@ namespace Suspension::Fluid
           }
         u.integrate(EvaluationFlags::values | EvaluationFlags::gradients);
       });
-    for (const unsigned int i : constrained)
-      diagonal.local_element(i) = 1.;
-    for (auto &d : diagonal)
-      d = d > 0. ? 1. / d : 1.;
   }
 
   template <int dim>
@@ -97,10 +103,14 @@ namespace Suspension::Fluid
       return;
     mass      = mass_;
     viscosity = viscosity_;
-    if (degree == 2)
-      compute_diagonal<2, 3>();
-    else
-      compute_diagonal<-1, 0>();
+    Vector &diagonal = inverse_diagonal.get_vector();
+    diagonal.reinit(mass_diagonal, true);
+    diagonal.equ(mass, mass_diagonal);
+    diagonal.add(viscosity, viscous_diagonal);
+    for (const unsigned int i : constrained)
+      diagonal.local_element(i) = 1.;
+    for (auto &d : diagonal)
+      d = d > 0. ? 1. / d : 1.;
   }
 
   template <int dim>

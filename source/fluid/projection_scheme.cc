@@ -190,11 +190,17 @@ namespace Suspension::Fluid
   }
 
   template <int dim>
-  void ProjectionScheme<dim>::update_unit_response()
+  void ProjectionScheme<dim>::update_unit_response(const double guess_scale)
   {
     VectorType b(operators.unit_force);
     b /= parameters.material.density;
-    unit_response = 0.;
+    // the operator is mass-dominated, so the response scales nearly as
+    // dt / alpha: the old one, scaled, is a close initial guess (after a
+    // mesh change the vector is new and zero)
+    if (guess_scale > 0.)
+      unit_response *= guess_scale;
+    else
+      unit_response = 0.;
     operators.solve_momentum(unit_response, b, parameters.fluid_solver.solver_tolerance);
     space.velocity_constraints.distribute(unit_response);
   }
@@ -263,7 +269,9 @@ namespace Suspension::Fluid
         report.matrices_rebuilt = true;
         // (with a step matrix the response is recomputed every step)
         if (driven && !operators.step_matrix)
-          update_unit_response();
+          update_unit_response(old_alpha_over_dt > 0. ?
+                                 old_alpha_over_dt / operators.momentum_alpha_over_dt :
+                                 0.);
       }
 
     // Extrapolated velocity (convection), history (time derivative) and

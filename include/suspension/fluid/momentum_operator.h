@@ -15,9 +15,10 @@ namespace Suspension::Fluid
    * assembled matrix (issue 14, item 1): applied cell by cell with
    * FEEvaluation (sum factorisation), the hanging-node, periodic and
    * Dirichlet constraints of the velocity resolved on the fly; CG with the
-   * Jacobi preconditioner of its diagonal, computed matrix-free. A change of
-   * dt costs one diagonal (one pass over the cells); a mesh change only the
-   * MatrixFree data. The vectors of the rest of the fluid stay PETSc's: a
+   * Jacobi preconditioner of its diagonal, computed matrix-free: the
+   * diagonals of M and of K once per mesh, so that a change of dt costs
+   * one vector update (with the adaptive time step dt changes every step);
+   * a mesh change only the MatrixFree data and those two diagonals. The vectors of the rest of the fluid stay PETSc's: a
    * solve copies the right-hand side in and the solution out (locally
    * owned entries; the same DoF numbering).
    */
@@ -48,13 +49,15 @@ namespace Suspension::Fluid
   private:
     template <int degree, int n_q>
     void apply_cells(Vector &dst, const Vector &src) const;
+    /// diag(mass M + viscosity K) into `diagonal`
     template <int degree, int n_q>
-    void compute_diagonal();
+    void compute_diagonal(Vector &diagonal, double mass, double viscosity) const;
 
     MatrixFree<dim, double> matrix_free;
     unsigned int            degree = 2;
     double                  mass = -1., viscosity = -1.;
     DiagonalMatrix<Vector>  inverse_diagonal;
+    Vector                  mass_diagonal, viscous_diagonal; // of M and K
     std::vector<unsigned int> constrained; // local indices, all constrained DoFs
     mutable Vector          x_local, b_local;
   };

@@ -125,7 +125,9 @@ namespace Suspension::Fluid
     /// Ghosted copies of the transferred time levels, handed to new
     /// SolutionTransfer objects.
     void       attach_time_levels(bool serialization);
-    void       update_unit_response();
+    /// the response to a unit pressure gradient, from the old one times
+    /// guess_scale (0: from zero)
+    void       update_unit_response(double guess_scale);
     double     flux(const VectorType &u) const;
 
     const Parameters::All &parameters;
