@@ -160,12 +160,14 @@ namespace Suspension::Fluid
                   const unsigned int ci = component[i];
                   const double       vi = fe_u.shape_value(i, q);
                   const auto        &gi = fe_u.shape_grad(i, q);
-                  for (unsigned int j = 0; j < nu; ++j)
-                    if (component[j] == ci)
-                      {
-                        cell_M(i, j) += vi * fe_u.shape_value(j, q) * JxW;
-                        cell_K(i, j) += gi * fe_u.shape_grad(j, q) * JxW;
-                      }
+                  // (M and K only for the assembled momentum operator)
+                  if (!matrix_free_momentum)
+                    for (unsigned int j = 0; j < nu; ++j)
+                      if (component[j] == ci)
+                        {
+                          cell_M(i, j) += vi * fe_u.shape_value(j, q) * JxW;
+                          cell_K(i, j) += gi * fe_u.shape_grad(j, q) * JxW;
+                        }
                   if (ci == 0)
                     {
                       cell_flux(i) += vi * JxW;

@@ -82,7 +82,9 @@ namespace Suspension::Solid
               }
             if (r.curvature != 0.)
               argument += r.curvature * (s2 - sn * sn / nn);
-            out[v] += r.weight * (0.5 * (1. + std::tanh(argument)) - dg_value[v]);
+            // 1/2 (1 + tanh a) = 1 / (1 + exp(-2a)): one exp, cheaper than
+            // glibc's tanh (which goes through expm1)
+            out[v] += r.weight * (1. / (1. + std::exp(-2. * argument)) - dg_value[v]);
           }
       return out;
     }
@@ -220,6 +222,30 @@ namespace Suspension::Solid
               for (unsigned int d = 0; d < dim; ++d)
                 cell_extent[cell * n_lanes + v][d] = box.side_length(d);
             }
+        // the phi DoFs of every lane (global, and local to the MatrixFree's
+        // vectors), for the exchange of the profiles with the ghost cells
+        {
+          const FiniteElement<dim>            &fe = dof_solid.get_fe();
+          const auto                           partitioner = matrix_free.get_vector_partitioner(0);
+          std::vector<types::global_dof_index> indices(fe.n_dofs_per_cell());
+          const unsigned int                   n_phi = base.n_dofs_per_cell();
+          lane_phi_dofs.assign(n_cells * n_lanes * n_phi, 0);
+          lane_phi_local.assign(n_cells * n_lanes * n_phi, 0);
+          for (unsigned int cell = 0; cell < n_cells; ++cell)
+            for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+              {
+                matrix_free.get_cell_iterator(cell, v)->get_dof_indices(indices);
+                for (unsigned int i = 0; i < indices.size(); ++i)
+                  {
+                    const auto [component, index] = fe.system_to_component_index(i);
+                    if (component != 0)
+                      continue;
+                    const std::size_t k = (cell * n_lanes + v) * n_phi + index;
+                    lane_phi_dofs[k]    = indices[i];
+                    lane_phi_local[k]   = partitioner->global_to_local(indices[i]);
+                  }
+              }
+        }
         // vertices across periodic faces are one vertex for the averages
         // (a particle that crosses the channel's periodic ends keeps its
         // normals): union of the matching vertices of periodic face pairs
@@ -347,14 +373,23 @@ namespace Suspension::Solid
     // mean is 1/2 + ln(cosh(beta (d + 1/2)) / cosh(beta (d - 1/2))) / (2 beta)
     const double q = std::exp(beta * (2. * mean - 1.)), b = std::exp(beta);
     double       d = std::clamp(std::log((1. - q * b) / (q - b)) / (2. * beta), lo, hi);
+    // 1/2 (1 + tanh(beta (P + d))) = 1 / (1 + exp(-2 beta P) exp(-2 beta d)):
+    // one exp per iteration instead of a tanh per point; the exponents are
+    // clamped where the profile is saturated to 1e-130 anyway, so that the
+    // product can neither overflow nor be 0 times infinity at large beta
+    const auto exp_clamped = [](const double x) { return std::exp(std::clamp(x, -300., 300.)); };
+    std::array<double, 64> exp_projection;
+    for (unsigned int q = 0; q < profile_points.size(); ++q)
+      exp_projection[q] = exp_clamped(-2. * beta * projection[q]);
     for (unsigned int iteration = 0; iteration < 60; ++iteration)
       {
-        double f = -mean, df = 0.;
+        double       f = -mean, df = 0.;
+        const double E = exp_clamped(-2. * beta * d);
         for (unsigned int q = 0; q < profile_points.size(); ++q)
           {
-            const double t = std::tanh(beta * (projection[q] + d));
-            f += profile_weights[q] * 0.5 * (1. + t);
-            df += profile_weights[q] * 0.5 * beta * (1. - t * t);
+            const double H = 1. / (1. + exp_projection[q] * E);
+            f += profile_weights[q] * H;
+            df += profile_weights[q] * 2. * beta * H * (1. - H);
           }
         if (std::abs(f) < 1e-14)
           break;
@@ -384,18 +419,13 @@ namespace Suspension::Solid
     const unsigned int n_owned  = matrix_free.n_cell_batches();
     const unsigned int n_ghosts = matrix_free.n_ghost_cell_batches();
     const unsigned int n_dofs   = mean_weights.size();
-    const FiniteElement<dim>            &fe = matrix_free.get_dof_handler(0).get_fe();
-    std::vector<types::global_dof_index> indices(fe.n_dofs_per_cell());
-    // the DoF indices of phi in a cell, in the lexicographic order of FE_DGQ
-    std::vector<types::global_dof_index> phi_indices(n_dofs);
+    // the DoF indices of phi in a cell (lexicographic, as FE_DGQ numbers
+    // them), global and local to the vectors of the MatrixFree
+    const types::global_dof_index *phi_indices = nullptr;
+    const unsigned int            *phi_local   = nullptr;
     const auto phi_dofs = [&](const unsigned int cell, const unsigned int v) {
-      matrix_free.get_cell_iterator(cell, v)->get_dof_indices(indices);
-      for (unsigned int i = 0; i < indices.size(); ++i)
-        {
-          const auto [component, index] = fe.system_to_component_index(i);
-          if (component == 0)
-            phi_indices[index] = indices[i];
-        }
+      phi_indices = &lane_phi_dofs[(cell * n_lanes + v) * n_dofs];
+      phi_local   = &lane_phi_local[(cell * n_lanes + v) * n_dofs];
     };
 
     // 1. cell means
@@ -545,11 +575,11 @@ namespace Suspension::Solid
           {
             phi_dofs(cell, v);
             if (thinc_curved)
-              ghosted_curvature(phi_indices[0]) = r.curvature;
-            ghosted(phi_indices[0]) = r.weight;
-            ghosted(phi_indices[1]) = r.offset;
+              ghosted_curvature.local_element(phi_local[0]) = r.curvature;
+            ghosted.local_element(phi_local[0]) = r.weight;
+            ghosted.local_element(phi_local[1]) = r.offset;
             for (unsigned int c = 0; c < dim; ++c)
-              ghosted(phi_indices[2 + c]) = r.slope[c];
+              ghosted.local_element(phi_local[2 + c]) = r.slope[c];
           }
     ghosted.update_ghost_values();
     if (thinc_curved)
@@ -561,11 +591,11 @@ namespace Suspension::Solid
           auto &r  = reconstruction[cell][v];
           r.lower  = cell_corner[cell * n_lanes + v];
           r.upper  = cell_corner[cell * n_lanes + v] + cell_extent[cell * n_lanes + v];
-          r.weight    = ghosted(phi_indices[0]);
-          r.curvature = thinc_curved ? ghosted_curvature(phi_indices[0]) : 0.;
-          r.offset = ghosted(phi_indices[1]);
+          r.weight    = ghosted.local_element(phi_local[0]);
+          r.curvature = thinc_curved ? ghosted_curvature.local_element(phi_local[0]) : 0.;
+          r.offset = ghosted.local_element(phi_local[1]);
           for (unsigned int c = 0; c < dim; ++c)
-            r.slope[c] = ghosted(phi_indices[2 + c]);
+            r.slope[c] = ghosted.local_element(phi_local[2 + c]);
         }
     ghosted.zero_out_ghost_values();
     if (thinc_curved)

@@ -205,6 +205,10 @@ namespace Suspension::Solid
     std::vector<Point<dim>> profile_points;
     std::vector<double>     profile_weights;
     std::vector<unsigned int>           cell_vertices;
+    /// the phi DoFs of the cells and ghost cells by lane: global indices
+    /// and indices local to the MatrixFree's vectors
+    std::vector<types::global_dof_index> lane_phi_dofs;
+    std::vector<unsigned int>            lane_phi_local;
     mutable std::vector<double>         vertex_mean, vertex_weight;
     mutable std::vector<double>         cell_mean;
     mutable AlignedVector<Lanes>        reconstruction;
