@@ -1069,10 +1069,14 @@ namespace Suspension::Solid
               capacity += mean[k] * (1. - mean[k]) * vol;
           }
       }
-    const MPI_Comm comm = matrix_free.get_dof_handler(0).get_communicator();
-    excess              = Utilities::MPI::sum(excess, comm);
-    capacity            = Utilities::MPI::sum(capacity, comm);
-    const bool   redistribute = scale && Utilities::MPI::max(report.out_of_bound_means, comm) > 0;
+    // one reduction instead of three (the limiter runs after every stage)
+    const MPI_Comm comm     = matrix_free.get_dof_handler(0).get_communicator();
+    const double   local[3] = {excess, capacity, double(report.out_of_bound_means)};
+    double         global[3];
+    Utilities::MPI::sum(ArrayView<const double>(local, 3), comm, ArrayView<double>(global, 3));
+    excess                  = global[0];
+    capacity                = global[1];
+    const bool   redistribute = scale && global[2] > 0.;
     const double lambda       = (redistribute && capacity > 0.) ? excess / capacity : 0.;
 
     // Pass 2: new means, then Zhang-Shu scaling towards them.
