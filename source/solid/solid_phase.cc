@@ -483,7 +483,7 @@ namespace Suspension::Solid
             }
         }
     // matrix-free over the faces (FEInterfaceValues, which builds a map of
-    // the DoFs of both cells at every face, took 14 % of the main job)
+    // the DoFs of both cells at every face, took 19 % of the main job)
     surface += transport.face_jumps(solution, touches_solid);
     const MPI_Comm comm = dof_handler.get_communicator();
     d.volume       = Utilities::MPI::sum(volume + volume_error, comm);

@@ -18,9 +18,10 @@ namespace Suspension::Fluid
    * Jacobi preconditioner of its diagonal, computed matrix-free: the
    * diagonals of M and of K once per mesh, so that a change of dt costs
    * one vector update (with the adaptive time step dt changes every step);
-   * a mesh change only the MatrixFree data and those two diagonals. The vectors of the rest of the fluid stay PETSc's: a
-   * solve copies the right-hand side in and the solution out (locally
-   * owned entries; the same DoF numbering).
+   * a mesh change only the MatrixFree data and those two diagonals. The
+   * vectors of the rest of the fluid stay PETSc's: a solve copies the
+   * right-hand side in and the solution out (locally owned entries; the
+   * same DoF numbering).
    */
   using VectorType = LinearAlgebraPETSc::MPI::Vector;
 
