@@ -7,6 +7,7 @@
 #include <suspension/core/memory.h>
 #include <suspension/core/parameters.h>
 #include <suspension/core/study.h>
+#include <suspension/core/study_cases.h>
 
 #include <filesystem>
 #include <fstream>
@@ -24,6 +25,9 @@ namespace
     "                                      --resume: continue from the checkpoint in\n"
     "                                      <Output directory>/checkpoint/ (same FILE.prm);\n"
     "                                      --set: change one entry of FILE.prm\n"
+    "       suspension FILE.prm --list-cases [--set ...]\n"
+    "                                      the cases of FILE.prm's 'Study' subsection\n"
+    "                                      as JSON (read by scripts/study), nothing run\n"
     "       suspension --print-parameters [2|3] [--json]\n"
     "                                      every entry, its default and documentation\n"
     "       suspension --help              this text\n";
@@ -75,10 +79,13 @@ int main(int argc, char *argv[])
 
   const std::string filename = args[0];
   bool              resume   = false;
+  bool              list_cases = false;
   std::vector<std::pair<std::string, std::string>> overrides;
   for (unsigned int i = 1; i < args.size(); ++i)
     if (args[i] == "--resume")
       resume = true;
+    else if (args[i] == "--list-cases")
+      list_cases = true;
     else if (args[i] == "--set" && i + 1 < args.size() &&
              args[i + 1].find('=') == std::string::npos)
       return fail("--set '" + args[i + 1] + "': expected --set 'Section/Entry=value'");
@@ -105,6 +112,13 @@ int main(int argc, char *argv[])
           dim = std::stoi(value);
       parameters             = Parameters::read(filename, dim, overrides);
       parameters.checkpoint.resume = resume;
+      if (list_cases)
+        {
+          const auto cases = study_cases(parameters);
+          if (dealii::Utilities::MPI::this_mpi_process(MPI_COMM_WORLD) == 0)
+            write_study_cases(std::cout, parameters, cases);
+          return 0;
+        }
       // a mesh that cannot fit stops here, before anything is written
       check_memory(parameters, MPI_COMM_WORLD);
     }

@@ -1075,6 +1075,28 @@ namespace Suspension::Parameters
                       "onto each other bin by bin. Best a divisor of the "
                       "number of cells across the channel, so that no cell "
                       "straddles two bins (the run notes it if one does).");
+    prm.declare_entry("Steady state window", std::to_string(d.steady_window),
+                      Patterns::Double(0.),
+                      "0: the flow is taken as statistically steady from "
+                      "'Start time' on. > 0: measured instead: from 'Start "
+                      "time' on, the samples' effective viscosity and the "
+                      "solid's mean distance from the walls are averaged over "
+                      "the last two windows of this length (time units); once "
+                      "both means change by less than 'Steady state "
+                      "tolerance' from one window to the next, the flow is "
+                      "steady, the sums start again from that sample, and the "
+                      "run prints the criterion with its result. A run that "
+                      "ends before says so and calls its numbers provisional.");
+    prm.declare_entry("Steady state tolerance", std::to_string(d.steady_tolerance),
+                      Patterns::Double(0.),
+                      "Relative change between the two windows' means below "
+                      "which the flow counts as steady (see 'Steady state "
+                      "window').");
+    prm.declare_entry("Sampling time", std::to_string(d.sampling_time),
+                      Patterns::Double(0.),
+                      "0: sample until 'Time stepping/End time'. > 0: end the "
+                      "run once the statistics cover this much steady time "
+                      "('End time' stays the limit).");
     prm.leave_subsection();
   }
 
@@ -1085,7 +1107,13 @@ namespace Suspension::Parameters
     start_time      = prm.get_double("Start time");
     sample_interval = prm.get_integer("Sample interval");
     n_bins          = prm.get_integer("Number of bins");
+    steady_window    = prm.get_double("Steady state window");
+    steady_tolerance = prm.get_double("Steady state tolerance");
+    sampling_time    = prm.get_double("Sampling time");
     prm.leave_subsection();
+    if (enabled && steady_window > 0 && !(steady_tolerance > 0))
+      throw InputError("Statistics/Steady state tolerance",
+                       "must be positive when 'Steady state window' is set");
     if (enabled && n_bins % 2 != 0)
       throw InputError("Statistics/Number of bins",
                        "must be even, so that the two channel halves fold "
@@ -1290,6 +1318,7 @@ namespace Suspension::Parameters
     Statistics::declare(prm);
     Verification::declare(prm, dim);
     Checkpoint::declare(prm);
+    Study::declare(prm);
   }
 
   void All::parse(ParameterHandler &prm, const unsigned int dim)
@@ -1309,6 +1338,7 @@ namespace Suspension::Parameters
     statistics.parse(prm);
     verification.parse(prm, dim);
     checkpoint.parse(prm);
+    study.parse(prm);
 
     // a channel is bounded by its walls: periodic wall faces would make it
     // a periodic box that the channel's statistics and contact take for one

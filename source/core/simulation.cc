@@ -932,7 +932,10 @@ namespace Suspension
              std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     };
     bool                steady       = false;
-    while (fluid.time() < ts.end_time * (1. - 1e-12) && !steady &&
+    const auto sampled_enough = [&]() {
+      return channel_statistics && channel_statistics->complete();
+    };
+    while (fluid.time() < ts.end_time * (1. - 1e-12) && !steady && !sampled_enough() &&
            (ts.maximum_steps == 0 || fluid.step_number() < ts.maximum_steps))
       {
         const auto step_start = std::chrono::steady_clock::now();
@@ -1068,6 +1071,9 @@ namespace Suspension
       }
     if (steady)
       pcout << "  steady state reached" << std::endl;
+    if (sampled_enough())
+      pcout << "  statistics complete: 'Statistics/Sampling time' of steady flow sampled by t = "
+            << fluid.time() << std::endl;
     if (last_output_time != fluid.time())
       write_output();
     write_tables();

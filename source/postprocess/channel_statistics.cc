@@ -137,7 +137,45 @@ namespace Suspension::Postprocess
     , n_bins(parameters.statistics.n_bins)
     , sums(n_bins, std::vector<double>(n_stored, 0.))
     , budget(n_budget)
+    , series(4 + n_budget)
+    , steadiness(parameters.statistics.steady_window, parameters.statistics.steady_tolerance)
   {}
+
+  template <int dim>
+  bool ChannelStatistics<dim>::complete() const
+  {
+    const double sampling = parameters.statistics.sampling_time;
+    const double since    = steadiness.measured() ? steadiness.steady_time() : first_time;
+    return n_sampled > 0 && steadiness.steady() && sampling > 0 &&
+           last_time - since >= sampling * (1. - 1e-9);
+  }
+
+  template <int dim>
+  void ChannelStatistics<dim>::restart_sums()
+  {
+    for (auto &bin : sums)
+      std::fill(bin.begin(), bin.end(), 0.);
+    n_sampled = 0;
+    for (RunningMean *r : {&driving, &viscosity_ratio, &n1, &n2})
+      *r = RunningMean();
+    for (auto &r : budget)
+      r = RunningMean();
+    for (auto &s : series)
+      s.clear();
+    sample_times.clear();
+  }
+
+  template <int dim>
+  double ChannelStatistics<dim>::error(const unsigned int quantity) const
+  {
+    return blocked_error(series[quantity]).error;
+  }
+
+  template <int dim>
+  std::string ChannelStatistics<dim>::stationarity() const
+  {
+    return steadiness.describe({"mu_eff", "solid wall distance"}, last_time);
+  }
 
   template <int dim>
   bool ChannelStatistics<dim>::due(const double time, const unsigned int step) const
@@ -293,25 +331,50 @@ namespace Suspension::Postprocess
         m[vv]        = f[1];
         m[ww]        = f[2];
         m[uv]        = f[3];
-        for (unsigned int c = 0; c < n_stored; ++c)
-          sums[k][c] += m[c];
       }
     AssertThrow(total_volume > 0., ExcMessage("channel statistics: empty channel"));
     const double bulk_velocity = global[n_bins * n_integrated] / total_volume;
 
     straddling_cells = std::max(straddling_cells, static_cast<unsigned long long>(
                                                     global[n_bins * n_integrated + 3]));
+    const double viscosity_ratio_s = driving_force / (3. * mu * bulk_velocity / (h * h));
+    if (steadiness.measured() && !steadiness.steady())
+      {
+        // the migration: the solid's mean distance from the walls
+        double solid = 0., weighted = 0.;
+        for (unsigned int k = 0; k < n_bins; ++k)
+          if (means[k][volume] > 0.)
+            {
+              solid += means[k][phi] * means[k][volume];
+              weighted += means[k][phi] * means[k][volume] * (h - std::abs(means[k][y]));
+            }
+        if (steadiness.add(time, {viscosity_ratio_s, solid > 0. ? weighted / solid : h}))
+          restart_sums(); // this sample is the first of the steady state
+      }
+    for (unsigned int k = 0; k < n_bins; ++k)
+      for (unsigned int c = 0; c < n_stored; ++c)
+        sums[k][c] += means[k][c];
     if (n_sampled == 0)
       first_time = time;
     last_time = time;
     ++n_sampled;
-    driving.add(driving_force);
-    viscosity_ratio.add(driving_force / (3. * mu * bulk_velocity / (h * h)));
-    n1.add(global[n_bins * n_integrated + 1] / total_volume);
-    n2.add(global[n_bins * n_integrated + 2] / total_volume);
     const auto p = fold(means, driving_force);
+    const std::vector<double> bulk = {driving_force, viscosity_ratio_s,
+                                      global[n_bins * n_integrated + 1] / total_volume,
+                                      global[n_bins * n_integrated + 2] / total_volume};
+    driving.add(bulk[0]);
+    viscosity_ratio.add(bulk[1]);
+    n1.add(bulk[2]);
+    n2.add(bulk[3]);
+    for (unsigned int q = 0; q < 4; ++q)
+      series[q].push_back(bulk[q]);
+    sample_times.push_back(time);
     for (unsigned int b = 0; b < n_budget; ++b)
-      budget[b].add(half_channel_mean(p, b));
+      {
+        const double value = half_channel_mean(p, b);
+        budget[b].add(value);
+        series[4 + b].push_back(value);
+      }
   }
 
   template <int dim>
@@ -440,8 +503,10 @@ namespace Suspension::Postprocess
     }
 
     TableHandler bulk;
-    const auto   with_error = [&](const std::string &name, const RunningMean &x) {
-      for (const auto &[n, value] : {std::pair{name, x.mean}, std::pair{name + "_error", x.error()}})
+    const auto   with_error = [&](const std::string &name, const RunningMean &x,
+                                const unsigned int quantity) {
+      for (const auto &[n, value] :
+           {std::pair{name, x.mean}, std::pair{name + "_error", error(quantity)}})
         {
           bulk.add_value(n, value);
           bulk.set_scientific(n, true);
@@ -451,12 +516,19 @@ namespace Suspension::Postprocess
     bulk.add_value("n_samples", n_sampled);
     bulk.add_value("time_first", first_time);
     bulk.add_value("time_last", last_time);
-    with_error("driving_force", driving);
-    with_error("viscosity_ratio", viscosity_ratio);
-    with_error("N1", n1);
-    with_error("N2", n2);
+    // 1 if the samples cover a statistically steady state by the measured
+    // criterion (or by assumption, with 'Steady state window' = 0)
+    bulk.add_value("steady", steadiness.steady() ? 1 : 0);
+    bulk.add_value("steady_measured", steadiness.measured() ? 1 : 0);
+    // 0: fewer samples than blocking needs for their correlation (the
+    // errors are lower bounds)
+    bulk.add_value("errors_converged", blocked_error(series[1]).converged ? 1 : 0);
+    with_error("driving_force", driving, 0);
+    with_error("viscosity_ratio", viscosity_ratio, 1);
+    with_error("N1", n1, 2);
+    with_error("N2", n2, 3);
     for (unsigned int b = 0; b < n_budget; ++b)
-      with_error(std::string("budget_") + budget_names[b], budget[b]);
+      with_error(std::string("budget_") + budget_names[b], budget[b], 4 + b);
     for (unsigned int b = 0; b < n_budget; ++b)
       {
         const std::string name = std::string("fraction_") + budget_names[b];
@@ -467,8 +539,30 @@ namespace Suspension::Postprocess
     bulk.add_value("straddling_cells", straddling_cells);
     bulk.add_value("linear_deviation", linear_deviation(p));
     bulk.set_scientific("linear_deviation", true);
-    std::ofstream out(directory + "/rheology.txt");
-    bulk.write_text(out, TableHandler::table_with_separate_column_description);
+    {
+      std::ofstream out(directory + "/rheology.txt");
+      bulk.write_text(out, TableHandler::table_with_separate_column_description);
+    }
+    std::ofstream(directory + "/stationarity.txt") << stationarity() << "\n";
+
+    // the series behind the errors, for a look at their correlation
+    TableHandler samples;
+    const char  *names[] = {"driving_force", "viscosity_ratio", "N1", "N2"};
+    for (std::size_t i = 0; i < sample_times.size(); ++i)
+      {
+        samples.add_value("time", sample_times[i]);
+        for (unsigned int q = 0; q < 4 + n_budget; ++q)
+          {
+            const std::string name =
+              q < 4 ? std::string(names[q]) : std::string("budget_") + budget_names[q - 4];
+            samples.add_value(name, series[q][i]);
+            samples.set_scientific(name, true);
+            samples.set_precision(name, 10);
+          }
+      }
+    samples.set_precision("time", 10);
+    std::ofstream out(directory + "/samples.txt");
+    samples.write_text(out, TableHandler::table_with_separate_column_description);
   }
 
   template <int dim>
@@ -487,13 +581,17 @@ namespace Suspension::Postprocess
       s << std::fixed << std::setprecision(digits) << rounded(x, digits);
       return s.str();
     };
-    const auto   plus_minus = [&](const RunningMean &x) {
-      return fixed(x.mean, 6) + " +- " + fixed(x.error(), 6);
+    const auto   plus_minus = [&](const RunningMean &x, const unsigned int quantity) {
+      return fixed(x.mean, 6) + " +- " + fixed(error(quantity), 6);
     };
     out << "  channel statistics: " << n_sampled << " samples, t = " << rounded(first_time, 6)
         << " to " << rounded(last_time, 6) << std::endl;
-    out << "  mu_eff/mu = " << plus_minus(viscosity_ratio) << ", N1 = " << plus_minus(n1)
-        << ", N2 = " << plus_minus(n2) << std::endl;
+    out << "  stationarity: " << stationarity() << std::endl;
+    const bool converged = blocked_error(series[1]).converged;
+    out << "  mu_eff/mu = " << plus_minus(viscosity_ratio, 1) << ", N1 = " << plus_minus(n1, 2)
+        << ", N2 = " << plus_minus(n2, 3) << " (errors: blocked batch means"
+        << (converged ? "" : "; lower bounds, the samples are too few for their correlation")
+        << ")" << std::endl;
     out << "  shear-stress budget (half-channel mean):";
     for (unsigned int b = 0; b < b_total; ++b)
       out << (b > 0 ? ", " : " ") << budget_names[b] << " "
@@ -541,6 +639,15 @@ namespace Suspension::Postprocess
       out << r->n << " " << r->mean << " " << r->m2 << "\n";
     for (const auto &r : budget)
       out << r.n << " " << r.mean << " " << r.m2 << "\n";
+    for (unsigned int i = 0; i <= series.size(); ++i)
+      {
+        const auto &q = i < series.size() ? series[i] : sample_times;
+        out << q.size();
+        for (const double x : q)
+          out << " " << x;
+        out << "\n";
+      }
+    steadiness.save(out);
   }
 
   template <int dim>
@@ -559,7 +666,17 @@ namespace Suspension::Postprocess
       in >> r->n >> r->mean >> r->m2;
     for (auto &r : budget)
       in >> r.n >> r.mean >> r.m2;
+    for (unsigned int i = 0; i <= series.size(); ++i)
+      {
+        auto       &q = i < series.size() ? series[i] : sample_times;
+        std::size_t n = 0;
+        in >> n;
+        q.assign(n, 0.);
+        for (double &x : q)
+          in >> x;
+      }
     AssertThrow(!in.fail(), ExcMessage("channel statistics: cannot read the saved sums"));
+    steadiness.load(in);
   }
 
   template class ChannelStatistics<2>;

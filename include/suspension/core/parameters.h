@@ -306,6 +306,13 @@ namespace Suspension::Parameters
     double       start_time      = 0.;
     unsigned int sample_interval = 10; // steps
     unsigned int n_bins          = 64; // across the whole channel
+    /// Stationarity: 0 takes it for granted from start_time on; > 0
+    /// compares the means over the last two windows of this length
+    double       steady_window    = 0.;
+    double       steady_tolerance = 0.005; // relative change allowed
+    /// 0: sample to the end time; > 0: end the run after this much
+    /// statistically steady time
+    double       sampling_time    = 0.;
 
     static void declare(ParameterHandler &prm);
     void        parse(ParameterHandler &prm);
@@ -322,6 +329,26 @@ namespace Suspension::Parameters
   {
     none,
     ghia_re100
+  };
+
+  enum class StudyCases
+  {
+    grid,  // every Re x Ca x Phi
+    paper  // the paper's seven (Re, Ca) pairs x Phi
+  };
+
+  /// A study of cases that differ in Re, Ca and Phi (scripts/study); the
+  /// scene itself is the base case. Declared and parsed in
+  /// core/study_cases.cc, next to the code that turns it into cases.
+  struct Study
+  {
+    StudyCases          cases = StudyCases::grid;
+    std::vector<double> reynolds_numbers, capillary_numbers, volume_fractions;
+    std::string         directory = "output/study";
+    unsigned int        ranks_per_case = 1;
+
+    static void declare(ParameterHandler &prm);
+    void        parse(ParameterHandler &prm);
   };
 
   /// What the run is compared with, and how a study repeats it.
@@ -393,6 +420,7 @@ namespace Suspension::Parameters
     Statistics         statistics;
     Verification       verification;
     Checkpoint         checkpoint;
+    Study              study;
 
     static void declare(ParameterHandler &prm, unsigned int dim);
     void        parse(ParameterHandler &prm, unsigned int dim);

@@ -9,6 +9,7 @@
 #include <suspension/fluid/fluid_operators.h>
 #include <suspension/fluid/fluid_space.h>
 #include <suspension/fluid/momentum_source.h>
+#include <suspension/postprocess/stationarity.h>
 
 #include <array>
 #include <iosfwd>
@@ -73,11 +74,19 @@ namespace Suspension::Postprocess
    * channel, also as a fraction of the average of tau_total.
    *
    * Bulk rheology per sample, then mean and standard error over samples
-   * (samples are correlated in time: the error is a lower bound):
+   * (samples are correlated in time: the error is the blocking estimate,
+   * BlockedError, from the series of samples kept for it):
    *   mu_eff / mu = Pi_s / (3 mu V_s / h^2), V_s the sample's bulk velocity,
    *   N1 = <sigma_xx - sigma_yy>_V = <G phi (B_xx - B_yy) + 2 mu (du/dx - dv/dy)>_V,
    *   N2 = <sigma_yy - sigma_zz>_V = <G phi (B_yy - B_zz) + 2 mu (dv/dy - dw/dz)>_V,
    * in 2D with B_zz = 1 and dw/dz = 0 (plane strain).
+   *
+   * Stationarity ('Steady state window' > 0): every sample also feeds a
+   * SteadyStateDetector with mu_eff and the solid's mean distance from
+   * the walls, int phi (h - |y|) / int phi (the migration); when both stop
+   * drifting all sums start again, so that the result covers the steady
+   * state only, and complete() tells the run when 'Sampling time' of it
+   * has been collected.
    *
    * The sums are MPI-reduced at every sample, so every rank holds them;
    * write() writes on rank 0 only.
@@ -103,7 +112,12 @@ namespace Suspension::Postprocess
 
     unsigned int n_samples() const { return n_sampled; }
 
-    /// profiles.txt and rheology.txt in `directory` (rank 0 only).
+    /// Steady, and 'Sampling time' (if set) covered since.
+    bool complete() const;
+
+    /// profiles.txt, rheology.txt, stationarity.txt and samples.txt (the
+    /// per-sample bulk values of the steady part) in `directory` (rank 0
+    /// only).
     void write(const std::string &directory) const;
 
     /// A few rounded lines for the screen; with tolerance > 0 and an
@@ -130,6 +144,12 @@ namespace Suspension::Postprocess
     double   linear_deviation(const Profiles &p) const;
     /// the mean over samples
     Profiles profiles() const;
+    /// every sum and mean back to no samples (the flow became steady)
+    void     restart_sums();
+    /// the standard error of one bulk quantity's mean (see `series`)
+    double   error(unsigned int quantity) const;
+    /// one line: steady from when, by what criterion, or why not
+    std::string stationarity() const;
 
     const Parameters::All &parameters;
     MPI_Comm               communicator;
@@ -147,5 +167,10 @@ namespace Suspension::Postprocess
     /// per-sample folded half-channel budget: viscous, Reynolds, elastic,
     /// collision, total
     std::vector<RunningMean> budget;
+    /// per sample: driving force, mu_eff/mu, N1, N2, the five budget terms
+    /// (for the correlated error)
+    std::vector<std::vector<double>> series;
+    std::vector<double>              sample_times;
+    SteadyStateDetector              steadiness;
   };
 } // namespace Suspension::Postprocess
