@@ -70,6 +70,10 @@ expect set_no_value       "$dir/valid.prm" --set Material/Viscosity -- "Material
 expect too_much_memory    "$dir/too_much_memory.prm" -- "too_much_memory.prm" "Mesh/Global refinements" "1.07e+09 cells" "kB per cell" "available" "more nodes"
 expect set_dimension      "$dir/valid.prm" --set Dimension=4 -- "Dimension" "4"
 expect directory_as_file  "$dir"                       -- "input_errors" "is a directory"
+# a study of a scene that is not a seeded channel suspension, or without cases
+expect study_not_channel  "$dir/valid.prm" --list-cases -- "valid.prm" "Geometry/Type" "channel"
+expect study_no_reynolds  "$dir/../../parameters/study_2d_paper.prm" --list-cases --set Study/Cases=grid -- "study_2d_paper.prm" "Study/Reynolds numbers" "no Reynolds number"
+expect study_bad_cases    "$dir/../../parameters/study_2d_paper.prm" --list-cases --set Study/Cases=papers -- "Study/Cases" "papers"
 
 echo "$failures failure(s)"
 [ "$failures" -eq 0 ]
