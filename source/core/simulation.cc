@@ -34,18 +34,10 @@ namespace Suspension
           << std::setw(2) << s % 60 << "s";
       return out.str();
     }
-  } // namespace
 
-  namespace
-  {
-    template <int dim>
-    std::string describe(const Solid::ParticleShape<dim> &s)
+    double seconds_since(const std::chrono::steady_clock::time_point start)
     {
-      std::ostringstream out;
-      out << "particle centroid (" << std::fixed << std::setprecision(4) << s.centroid
-          << "), D = " << s.taylor_deformation << ", inclination " << std::setprecision(2)
-          << s.inclination << " deg, area(phi >= 1/2) " << std::setprecision(5) << s.solid_area;
-      return out.str();
+      return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     }
   } // namespace
 
@@ -76,11 +68,17 @@ namespace Suspension
     if (parameters.fluid_solver.mode == Parameters::VelocityMode::prescribed)
       prescribed_velocity = make_function<dim>(parameters.fluid_solver.prescribed_velocity, dim);
     if (parameters.solid.enabled())
-      solid = std::make_unique<Solid::SolidPhase<dim>>(parameters, triangulation);
+      {
+        solid = std::make_unique<Solid::SolidPhase<dim>>(parameters, triangulation);
+        solid_report = std::make_unique<Postprocess::SolidReport<dim>>(parameters, *solid, space);
+      }
     if (parameters.solid.contact.enabled)
-      contact = std::make_unique<Solid::ContactForce<dim>>(parameters, scene.no_slip_walls(),
-                                                           scene.periods(), scene.lower_corner(),
-                                                           scene.upper_corner());
+      {
+        contact = std::make_unique<Solid::ContactForce<dim>>(parameters, scene.no_slip_walls(),
+                                                             scene.periods(), scene.lower_corner(),
+                                                             scene.upper_corner());
+        contact_report = std::make_unique<Postprocess::ContactReport>(parameters);
+      }
     if (parameters.statistics.enabled)
       channel_statistics =
         std::make_unique<Postprocess::ChannelStatistics<dim>>(parameters, communicator);
@@ -232,9 +230,8 @@ namespace Suspension
               << (channel_statistics ? part(*channel_statistics) : std::string());
       const unsigned long long worst = worst_coarse_interface;
       archive << dt << wall_time << last_output_time << last_driving_force << worst
-              << n_adaptations << n_outputs << closest_gap_seen << closest_wall_seen
-              << smallest_contact_cell << fewest_particles << most_particles
-              << last_probe_values << errors << last_errors.velocity_l2
+              << n_adaptations << n_outputs
+              << (contact_report ? part(*contact_report) : std::string()) << last_probe_values << errors << last_errors.velocity_l2
               << last_errors.velocity_l2_relative << last_errors.pressure_l2;
       archive << statistics << probes;
     }
@@ -281,12 +278,14 @@ namespace Suspension
     double              dt = 0.;
     unsigned long long  worst = 0;
     std::vector<double> errors;
+    std::string         contact_state;
     archive >> dt >> wall_time_before >> last_output_time >> last_driving_force >> worst >>
-      n_adaptations >> n_outputs >> closest_gap_seen >> closest_wall_seen >>
-      smallest_contact_cell >> fewest_particles >> most_particles >> last_probe_values >>
+      n_adaptations >> n_outputs >> contact_state >> last_probe_values >>
       errors >> last_errors.velocity_l2 >> last_errors.velocity_l2_relative >>
       last_errors.pressure_l2;
     worst_coarse_interface = worst;
+    if (contact_report)
+      part(*contact_report, contact_state);
     error_history.clear();
     for (std::size_t i = 0; i + 3 < errors.size(); i += 4)
       error_history.emplace_back(errors[i],
@@ -537,220 +536,12 @@ namespace Suspension
   }
 
   template <int dim>
-  void Simulation<dim>::add_solid_statistics(const Solid::SolidDiagnostics &d)
-  {
-    statistics.add_value("solid_volume", d.volume);
-    statistics.add_value("volume_drift", d.volume_drift);
-    statistics.add_value("phi_outflow", d.boundary_outflow);
-    statistics.add_value("mass_balance", d.mass_balance);
-    statistics.add_value("phi_min", d.min_phi);
-    statistics.add_value("phi_max", d.max_phi);
-    statistics.add_value("limited_cells", d.limited_cells);
-    statistics.add_value("bad_means", d.out_of_bound_means);
-    statistics.add_value("substeps", d.substeps);
-    statistics.add_value("interface_cells", d.interface_width);
-    std::vector<std::string> columns = {"solid_volume", "volume_drift", "phi_outflow",
-                                        "mass_balance", "phi_min", "phi_max", "interface_cells"};
-    if (parameters.solid.elastic())
-      {
-        statistics.add_value("detB_min", d.min_det_B);
-        statistics.add_value("eigB_min", d.min_eigenvalue_B);
-        statistics.add_value("eigB_max", d.max_eigenvalue_B);
-        statistics.add_value("tail_energy_share", d.tail_energy_share);
-        columns.insert(columns.end(), {"detB_min", "eigB_min", "eigB_max", "tail_energy_share"});
-        static const char *where[] = {"eigB_min_x", "eigB_min_y", "eigB_min_z"};
-        for (unsigned int c = 0; c < dim; ++c)
-          {
-            statistics.add_value(where[c], d.worst_B_location[c]);
-            columns.push_back(where[c]);
-          }
-      }
-    if (parameters.solid.particles.size() == 1)
-      {
-        const auto shape = solid->particle_shape(space, fluid.velocity());
-        static const char *x[] = {"x_c", "y_c", "z_c"}, *u[] = {"u_c", "v_c", "w_c"};
-        for (unsigned int d = 0; d < dim; ++d)
-          {
-            statistics.add_value(x[d], shape.centroid[d]);
-            statistics.add_value(u[d], shape.velocity[d]);
-            columns.push_back(x[d]);
-            columns.push_back(u[d]);
-          }
-        statistics.add_value("D", shape.taylor_deformation);
-        statistics.add_value("theta_deg", shape.inclination);
-        statistics.add_value("solid_area", shape.solid_area);
-        statistics.add_value("D_phi", shape.taylor_deformation_phi);
-        statistics.add_value("solid_area_subcell", shape.solid_area_subcell);
-        statistics.add_value("D_half", shape.taylor_deformation_half);
-        columns.insert(columns.end(),
-                       {"D", "theta_deg", "solid_area", "D_phi", "solid_area_subcell", "D_half"});
-        if (parameters.solid.elastic())
-          {
-            statistics.add_value("D_B", shape.taylor_deformation_B);
-            statistics.add_value("theta_B_deg", shape.inclination_B);
-            columns.insert(columns.end(), {"D_B", "theta_B_deg"});
-          }
-      }
-    for (const auto &c : columns)
-      {
-        statistics.set_scientific(c, true);
-        statistics.set_precision(c, 10);
-      }
-  }
-
-  template <int dim>
   void Simulation<dim>::update_contact_force()
   {
     if (!contact)
       return;
     TimerOutput::Scope scope(timer, "contact force");
-    contact_diagnostics = contact->update(*solid);
-    const auto &c       = contact_diagnostics;
-    const auto  smaller = [](const double seen, const double now) {
-      return now < 0. ? seen : seen < 0. ? now : std::min(seen, now);
-    };
-    closest_gap_seen  = smaller(closest_gap_seen, c.closest_gap);
-    closest_wall_seen = smaller(closest_wall_seen, c.closest_wall);
-    smallest_contact_cell = c.smallest_cell;
-    fewest_particles      = std::min(fewest_particles, c.n_particles);
-    most_particles        = std::max(most_particles, c.n_particles);
-  }
-
-  template <int dim>
-  void Simulation<dim>::add_contact_statistics()
-  {
-    const auto &c = contact_diagnostics;
-    statistics.add_value("particles", c.n_particles);
-    statistics.add_value("contact_cells", c.active_cells);
-    statistics.add_value("gap_min", c.closest_gap);
-    statistics.add_value("wall_gap_min", c.closest_wall);
-    statistics.add_value("contact_force_max", c.largest_force);
-    for (const auto &column : {"gap_min", "wall_gap_min", "contact_force_max"})
-      {
-        statistics.set_scientific(column, true);
-        statistics.set_precision(column, 6);
-      }
-  }
-
-  template <int dim>
-  void Simulation<dim>::report_contact() const
-  {
-    const double dx = smallest_contact_cell;
-    pcout << "  contact: particles labelled " << fewest_particles << " to " << most_particles
-          << " (seeded " << parameters.solid.particles.size() << "), interface cell dx = "
-          << std::setprecision(6) << dx << std::endl;
-    const auto in_cells = [&](const double gap) {
-      std::ostringstream out;
-      if (gap < 0.)
-        out << "none within " << parameters.solid.contact.range << " dx";
-      else
-        out << std::setprecision(4) << gap << " (" << std::setprecision(3) << gap / dx
-            << " dx)";
-      return out.str();
-    };
-    pcout << "  closest gap between particles " << in_cells(closest_gap_seen)
-          << ", closest to a wall " << in_cells(closest_wall_seen) << std::endl;
-    const bool apart =
-      fewest_particles == parameters.solid.particles.size() &&
-      most_particles == parameters.solid.particles.size() &&
-      (closest_gap_seen < 0. || closest_gap_seen >= dx) &&
-      (closest_wall_seen < 0. || closest_wall_seen >= dx);
-    pcout << "  particles never merged and kept a gap >= dx: " << (apart ? "yes" : "no")
-          << std::endl;
-  }
-
-  template <int dim>
-  void Simulation<dim>::report_solid_probes()
-  {
-    const auto &v = parameters.verification;
-    if (!v.exact_solid_at_probes.empty() && !parameters.output.probe_points.empty())
-      {
-        auto exact = make_function<dim>({v.exact_solid_at_probes, v.exact_velocity.constants},
-                                        1 + Solid::SolidPhase<dim>::n_B);
-        exact->set_time(fluid.time());
-        double worst = 0., worst_strain = 0.;
-        for (const auto &c : parameters.output.probe_points)
-          {
-            Point<dim> p;
-            for (unsigned int d = 0; d < dim; ++d)
-              p[d] = c[d];
-            const auto values = solid->values_at({p});
-            double     difference = 0., strain = 0.;
-            for (unsigned int k = 0; k < values[0].size(); ++k)
-              {
-                const double e = exact->value(p, k);
-                worst = std::max(worst, std::abs(values[0][k] - e) / std::max(1., std::abs(e)));
-                if (k == 0)
-                  continue;
-                // off-diagonal entries count twice in the Frobenius norm
-                const double w = k <= dim ? 1. : 2.;
-                difference += w * Utilities::fixed_power<2>(values[0][k] - e);
-                strain += w * Utilities::fixed_power<2>(e - (k <= dim ? 1. : 0.));
-              }
-            if (strain > 1e-20)
-              worst_strain = std::max(worst_strain, std::sqrt(difference / strain));
-          }
-        pcout << "  solid fields at probes: largest relative error " << std::scientific
-              << std::setprecision(2) << worst << ", of B - I " << worst_strain
-              << std::defaultfloat << std::endl;
-        worst = std::max(worst, worst_strain);
-        if (v.tolerance > 0)
-          pcout << "  <= " << v.tolerance << ": " << (worst <= v.tolerance ? "yes" : "no")
-                << std::endl;
-      }
-  }
-
-  template <int dim>
-  void Simulation<dim>::report_solid()
-  {
-    const auto &d = solid_diagnostics;
-    pcout << "  solid: volume " << std::scientific << std::setprecision(8) << d.volume
-          << ", relative drift " << std::setprecision(2) << d.volume_drift << ", phi in ["
-          << std::setprecision(6) << d.min_phi << ", " << d.max_phi << "]" << std::defaultfloat
-          << std::endl;
-    // The transport changes the integral of phi only by the flux through
-    // the boundary (integrated over the steps with the RK weights,
-    // SolidPhase::advance), so volume - initial volume + outflow is
-    // round-off, for closed boxes and open ones alike; its bound grows
-    // with the sub-steps (Solid::mass_balance_bound).
-    const double       bound = Solid::mass_balance_bound(d.updates);
-    std::ostringstream verdict;
-    verdict << "  mass balance (outflow " << std::scientific << std::setprecision(2)
-            << (d.initial_volume > 0. ? d.boundary_outflow / d.initial_volume : 0.)
-            << " of int phi(0)): residual " << d.mass_balance << " <= " << bound
-            << " (round-off bound, " << d.updates << " sub-steps and mesh changes): "
-            << (std::abs(d.mass_balance) <= bound ? "yes" : "no") << std::defaultfloat;
-    pcout << verdict.str() << ", 0 <= phi <= 1: "
-          << (d.min_phi >= -1e-14 && d.max_phi <= 1. + 1e-14 ? "yes" : "no") << std::endl;
-    if (parameters.solid.elastic())
-      pcout << "  B: min det " << std::scientific << std::setprecision(6) << d.min_det_B
-            << ", min eigenvalue " << d.min_eigenvalue_B << std::defaultfloat << std::endl;
-    std::ostringstream interface;
-    interface << "  interface: " << std::fixed << std::setprecision(2) << d.interface_width
-              << " cells across 0.01 < phi < 0.99";
-    if (parameters.solid.elastic())
-      interface << ", elastic energy where phi < 1/2: " << std::scientific << std::setprecision(2)
-                << 100. * d.tail_energy_share << " %";
-    pcout << interface.str() << std::endl;
-    if (parameters.solid.particles.size() == 1)
-      {
-        pcout << "  final: " << describe(solid->particle_shape(space, fluid.velocity()))
-              << std::endl;
-      }
-    report_solid_probes();
-    if (!parameters.verification.exact_fraction.empty())
-      {
-        const auto exact = make_function<dim>(
-          {parameters.verification.exact_fraction, parameters.verification.exact_velocity.constants},
-          1);
-        phi_l1_error = solid->l1_error(*exact);
-        phi_cell_l1_error = solid->cell_mean_l1_error(parameters.verification.exact_fraction,
-                                                      parameters.verification.exact_velocity.constants);
-        pcout << "  phi L1 error " << std::scientific << std::setprecision(4) << phi_l1_error
-              << "; of the cell means against the exact cell fractions " << phi_cell_l1_error
-              << ", over the initial volume " << phi_cell_l1_error / solid->initial_phi_volume()
-              << std::defaultfloat << std::endl;
-      }
+    contact_report->observe(contact->update(*solid));
   }
 
   template <int dim>
@@ -879,11 +670,10 @@ namespace Suspension
   }
 
   template <int dim>
-  RunSummary Simulation<dim>::run()
+  double Simulation<dim>::start()
   {
-    const auto &ts       = parameters.time_stepping;
-    const bool  resuming = parameters.checkpoint.resume;
-    double      dt       = ts.time_step;
+    const bool resuming = parameters.checkpoint.resume;
+    double     dt       = parameters.time_stepping.time_step;
     if (resuming)
       dt = resume(); // first: without a checkpoint, stop before writing anything
     // (the output directory exists: write_run_record() made it)
@@ -911,7 +701,6 @@ namespace Suspension
         pcout << line.str() << std::endl;
       }
 
-    std::vector<const Fluid::MomentumSource<dim> *> sources;
     if (body_force)
       sources.push_back(body_force.get());
     if (solid && solid->pushes_fluid())
@@ -921,154 +710,205 @@ namespace Suspension
     if (solid)
       solid_diagnostics = solid->diagnostics();
 
-    auto diagnostics = fluid.compute_diagnostics();
+    flow_diagnostics = fluid.compute_diagnostics();
     if (!resuming)
       write_output();
+    run_start = std::chrono::steady_clock::now();
+    return dt;
+  }
 
-    std::vector<double> report_times = parameters.verification.report_times;
-    const auto          start        = std::chrono::steady_clock::now();
-    const auto          elapsed      = [&]() {
-      return wall_time_before +
-             std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    };
-    bool                steady       = false;
-    const auto sampled_enough = [&]() {
-      return channel_statistics && channel_statistics->complete();
-    };
-    while (fluid.time() < ts.end_time * (1. - 1e-12) && !steady && !sampled_enough() &&
-           (ts.maximum_steps == 0 || fluid.step_number() < ts.maximum_steps))
+  template <int dim>
+  double Simulation<dim>::elapsed() const
+  {
+    return wall_time_before +
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - run_start).count();
+  }
+
+  template <int dim>
+  bool Simulation<dim>::running() const
+  {
+    const auto &ts = parameters.time_stepping;
+    return fluid.time() < ts.end_time * (1. - 1e-12) && !steady && !sampled_enough() &&
+           (ts.maximum_steps == 0 || fluid.step_number() < ts.maximum_steps);
+  }
+
+  template <int dim>
+  bool Simulation<dim>::sampled_enough() const
+  {
+    return channel_statistics && channel_statistics->complete();
+  }
+
+  template <int dim>
+  Fluid::StepReport Simulation<dim>::advance(const double dt)
+  {
+    if (prescribed_velocity)
       {
-        const auto step_start = std::chrono::steady_clock::now();
-        try
-          {
-            dt = choose_time_step(dt, fluid.time(), diagnostics);
-          }
-        catch (...)
-          {
-            write_output();
-            write_tables();
-            throw;
-          }
-
-        Fluid::StepReport report;
-        if (prescribed_velocity)
-          {
-            const Fluid::VectorType u_begin = fluid.velocity();
-            fluid.prescribe(dt, *prescribed_velocity);
-            if (solid)
-              {
-                TimerOutput::Scope scope(timer, "solid transport");
-                solid_diagnostics =
-                  solid->advance(dt, diagnostics.max_speed_over_h, u_begin, fluid.velocity());
-              }
-          }
-        else
-          {
-            if (solid)
-              {
-                TimerOutput::Scope scope(timer, "solid transport");
-                try
-                  {
-                    solid_diagnostics = solid->advance(dt, diagnostics.max_speed_over_h,
-                                                       fluid.velocity(),
-                                                       fluid.extrapolated_velocity(dt));
-                  }
-                catch (...)
-                  {
-                    // the state that failed the checks, for a look in ParaView
-                    write_output();
-                    write_tables();
-                    throw;
-                  }
-              }
-            update_contact_force();
-            try
-              {
-                report = fluid.advance(dt, sources);
-              }
-            catch (const SolverControl::NoConvergence &e)
-              {
-                write_output();
-                write_tables();
-                throw std::runtime_error(
-                  "a linear solver of the fluid step diverged at t = " +
-                  std::to_string(fluid.time() + dt) + " (residual " + std::to_string(e.last_residual) +
-                  "); reduce the time step or the CFL number; the last state was written");
-              }
-          }
-        {
-          TimerOutput::Scope scope(timer, "diagnostics");
-          diagnostics = fluid.compute_diagnostics();
-        }
-        if (!std::isfinite(diagnostics.kinetic_energy))
-          {
-            write_output();
-            write_tables();
-            throw std::runtime_error("the velocity is not finite (NaN or Inf) at t = " +
-                                     std::to_string(fluid.time()) +
-                                     "; reduce the time step or the CFL number");
-          }
-        steady = ts.steady_tolerance > 0 && fluid.relative_change_rate() < ts.steady_tolerance;
-
-        // statistics of the step on its own mesh, then the mesh for the next
-        const double wall =
-          std::chrono::duration<double>(std::chrono::steady_clock::now() - step_start).count();
-        add_statistics_row(report, diagnostics, dt, wall);
+        // the velocity is known: transport only, no Navier-Stokes step
+        const Fluid::VectorType u_begin = fluid.velocity();
+        fluid.prescribe(dt, *prescribed_velocity);
         if (solid)
-          add_solid_statistics(solid_diagnostics);
-        if (contact)
-          add_contact_statistics();
-        if (channel_statistics && channel_statistics->due(fluid.time(), fluid.step_number()))
-          sample_statistics(report.driving_force);
-        if (adaptor.enabled())
           {
-            const MeshLevels levels = adaptor.levels(solid.get());
-            worst_coarse_interface  = std::max(worst_coarse_interface, levels.coarse_interface_cells);
-            bool       adapted      = false;
-            const auto adapt_start  = std::chrono::steady_clock::now();
-            if (adaptor.due(diagnostics.max_speed * dt))
-              adapted = adapt_mesh();
-            if (adapted)
-              {
-                diagnostics = fluid.compute_diagnostics();
-                if (solid)
-                  solid_diagnostics = solid->diagnostics();
-              }
-            add_mesh_statistics(levels, adapted,
-                                std::chrono::duration<double>(std::chrono::steady_clock::now() -
-                                                              adapt_start)
-                                  .count());
+            TimerOutput::Scope scope(timer, "solid transport");
+            solid_diagnostics =
+              solid->advance(dt, flow_diagnostics.max_speed_over_h, u_begin, fluid.velocity());
           }
-        last_driving_force = report.driving_force;
-
-        for (const double t : report_times)
-          if (std::abs(t - fluid.time()) < 1e-9 * dt)
-            {
-              report_errors(fluid.time(), false);
-              if (solid)
-                report_solid_probes();
-              if (solid && parameters.solid.particles.size() == 1)
-                {
-                  const auto shape = solid->particle_shape(space, fluid.velocity());
-                  deformation_history.push_back(
-                    {fluid.time(), shape.taylor_deformation, shape.taylor_deformation_B});
-                  pcout << "  t = " << fluid.time() << ": " << describe(shape) << std::endl;
-                }
-            }
-        if (output_due(fluid.time(), dt))
-          {
-            write_output();
-            write_tables();
-          }
-        const auto &o = parameters.output;
-        if (o.progress_interval > 0 && fluid.step_number() % o.progress_interval == 0)
-          {
-            print_progress(dt, diagnostics, elapsed());
-            write_tables();
-          }
-        if (checkpoint.enabled() && checkpoint.due(fluid.step_number()))
-          write_checkpoint(dt, elapsed());
+        return Fluid::StepReport();
       }
+    if (solid)
+      {
+        TimerOutput::Scope scope(timer, "solid transport");
+        solid_diagnostics = solid->advance(dt, flow_diagnostics.max_speed_over_h, fluid.velocity(),
+                                           fluid.extrapolated_velocity(dt));
+      }
+    update_contact_force();
+    return fluid.advance(dt, sources);
+  }
+
+  template <int dim>
+  void Simulation<dim>::check_flow()
+  {
+    {
+      TimerOutput::Scope scope(timer, "diagnostics");
+      flow_diagnostics = fluid.compute_diagnostics();
+    }
+    if (!std::isfinite(flow_diagnostics.kinetic_energy))
+      throw std::runtime_error("the velocity is not finite (NaN or Inf) at t = " +
+                               std::to_string(fluid.time()) +
+                               "; reduce the time step or the CFL number");
+    const double tolerance = parameters.time_stepping.steady_tolerance;
+    steady = tolerance > 0 && fluid.relative_change_rate() < tolerance;
+  }
+
+  template <int dim>
+  void Simulation<dim>::record_step(const Fluid::StepReport &report, const double dt,
+                                    const double wall_time)
+  {
+    add_statistics_row(report, flow_diagnostics, dt, wall_time);
+    if (solid_report)
+      solid_report->add_columns(statistics, solid_diagnostics, fluid.velocity());
+    if (contact_report)
+      contact_report->add_columns(statistics);
+    if (channel_statistics && channel_statistics->due(fluid.time(), fluid.step_number()))
+      sample_statistics(report.driving_force);
+    last_driving_force = report.driving_force;
+  }
+
+  template <int dim>
+  void Simulation<dim>::adapt_if_due(const double dt)
+  {
+    if (!adaptor.enabled())
+      return;
+    const MeshLevels levels = adaptor.levels(solid.get());
+    worst_coarse_interface  = std::max(worst_coarse_interface, levels.coarse_interface_cells);
+    bool       adapted      = false;
+    const auto adapt_start  = std::chrono::steady_clock::now();
+    if (adaptor.due(flow_diagnostics.max_speed * dt))
+      adapted = adapt_mesh();
+    if (adapted)
+      {
+        flow_diagnostics = fluid.compute_diagnostics();
+        if (solid)
+          solid_diagnostics = solid->diagnostics();
+      }
+    add_mesh_statistics(levels, adapted,
+                        std::chrono::duration<double>(std::chrono::steady_clock::now() -
+                                                      adapt_start)
+                          .count());
+  }
+
+  template <int dim>
+  void Simulation<dim>::report_at_times(const double dt)
+  {
+    for (const double t : parameters.verification.report_times)
+      if (std::abs(t - fluid.time()) < 1e-9 * dt)
+        {
+          report_errors(fluid.time(), false);
+          if (solid_report)
+            solid_report->report_probes(pcout, fluid.time());
+          if (solid && parameters.solid.particles.size() == 1)
+            {
+              const auto shape = solid->particle_shape(space, fluid.velocity());
+              deformation_history.push_back(
+                {fluid.time(), shape.taylor_deformation, shape.taylor_deformation_B});
+              pcout << "  t = " << fluid.time() << ": " << Postprocess::describe(shape) << std::endl;
+            }
+        }
+  }
+
+  template <int dim>
+  void Simulation<dim>::write_if_due(const double dt)
+  {
+    if (output_due(fluid.time(), dt))
+      {
+        write_output();
+        write_tables();
+      }
+    const auto &o = parameters.output;
+    if (o.progress_interval > 0 && fluid.step_number() % o.progress_interval == 0)
+      {
+        print_progress(dt, flow_diagnostics, elapsed());
+        write_tables();
+      }
+    if (checkpoint.enabled() && checkpoint.due(fluid.step_number()))
+      write_checkpoint(dt, elapsed());
+  }
+
+  template <int dim>
+  void Simulation<dim>::write_last_state()
+  {
+    // the state that failed, for a look in ParaView; a second failure
+    // while writing must not hide the first
+    try
+      {
+        write_output();
+        write_tables();
+      }
+    catch (...)
+      {}
+  }
+
+  /// The time step as a sequence of calls; any failure writes the last
+  /// state once, here, and propagates as one line.
+  template <int dim>
+  RunSummary Simulation<dim>::run()
+  {
+    double dt = start();
+    try
+      {
+        while (running())
+          {
+            const auto step_start = std::chrono::steady_clock::now();
+            dt                    = choose_time_step(dt, fluid.time(), flow_diagnostics);
+            const auto report     = advance(dt); // transport, forces, fluid
+            check_flow();
+            // statistics of the step on its own mesh, then the mesh for the next
+            record_step(report, dt, seconds_since(step_start));
+            adapt_if_due(dt);
+            report_at_times(dt);
+            write_if_due(dt); // output, progress, checkpoint
+          }
+      }
+    catch (const SolverControl::NoConvergence &e)
+      {
+        write_last_state();
+        throw std::runtime_error(
+          "a linear solver diverged at t = " + std::to_string(fluid.time() + dt) + " (residual " +
+          std::to_string(e.last_residual) +
+          "); reduce the time step or the CFL number; the last state was written");
+      }
+    catch (...)
+      {
+        write_last_state();
+        throw;
+      }
+    return finish(dt);
+  }
+
+  /// The end of a run: the last output and every report.
+  template <int dim>
+  RunSummary Simulation<dim>::finish(const double dt)
+  {
+    const auto &diagnostics = flow_diagnostics;
     if (steady)
       pcout << "  steady state reached" << std::endl;
     if (sampled_enough())
@@ -1095,10 +935,10 @@ namespace Suspension
                 << worst_coarse_interface;
         pcout << std::endl;
       }
-    if (solid)
-      report_solid();
-    if (contact)
-      report_contact();
+    if (solid_report)
+      solid_report->report(pcout, solid_diagnostics, fluid.velocity(), fluid.time());
+    if (contact_report && pcout.is_active())
+      contact_report->report(pcout.get_stream());
     report_errors(fluid.time(), steady);
     report_verdicts(steady);
     if (channel_statistics && pcout.is_active())
@@ -1124,8 +964,11 @@ namespace Suspension
     RunSummary summary;
     summary.final_errors = last_errors;
     summary.errors       = error_history;
-    summary.phi_l1_error = phi_l1_error;
-    summary.phi_cell_l1_error = phi_cell_l1_error;
+    if (solid_report)
+      {
+        summary.phi_l1_error      = solid_report->phi_l1_error();
+        summary.phi_cell_l1_error = solid_report->phi_cell_l1_error();
+      }
     summary.deformation_history = deformation_history;
     if (solid && parameters.solid.particles.size() == 1)
       {

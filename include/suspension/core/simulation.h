@@ -1,6 +1,7 @@
 #pragma once
 
 #include <array>
+#include <chrono>
 
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/table_handler.h>
@@ -15,6 +16,8 @@
 #include <suspension/fluid/projection_scheme.h>
 #include <suspension/mesh/mesh_adaptor.h>
 #include <suspension/postprocess/channel_statistics.h>
+#include <suspension/postprocess/contact_report.h>
+#include <suspension/postprocess/solid_report.h>
 #include <suspension/postprocess/field_output.h>
 #include <suspension/postprocess/flow_verification.h>
 #include <suspension/solid/contact_force.h>
@@ -48,7 +51,9 @@ namespace Suspension
   /**
    * One run of a scene: builds the mesh and the parts, then advances in
    * time. Owns nothing numerical itself; run() reads as the time step:
-   * choose dt -> fluid step -> diagnostics -> statistics, output, progress.
+   * choose dt -> advance (transport, forces, fluid) -> check the flow ->
+   * record (statistics) -> adapt the mesh -> reports -> output, progress,
+   * checkpoint; a failure anywhere writes the last state once.
    */
   template <int dim>
   class Simulation
@@ -58,6 +63,27 @@ namespace Suspension
     RunSummary run();
 
   private:
+    /// setup() or resume(), the opening reports and the first output;
+    /// returns the time step to begin with
+    double start();
+    /// not yet at the end time, steady, sampled enough or the step limit
+    bool   running() const;
+    bool   sampled_enough() const;
+    /// the solid, the contact force and the fluid over one time step
+    Fluid::StepReport advance(double dt);
+    /// diagnostics of the new flow; throws if it is not finite
+    void   check_flow();
+    void   record_step(const Fluid::StepReport &report, double dt, double wall_time);
+    void   adapt_if_due(double dt);
+    /// 'Verification/Report times': errors, probes, the particle's shape
+    void   report_at_times(double dt);
+    void   write_if_due(double dt);
+    /// output and tables of a failed run (errors while writing ignored)
+    void   write_last_state();
+    /// the last output, the end-of-run reports and the summary
+    RunSummary finish(double dt);
+    /// wall seconds of the run, including those before a resume
+    double elapsed() const;
     void   setup();
     /// Instead of setup() with --resume: the mesh, fields and scalars of
     /// the last checkpoint. Returns the time step to continue with.
@@ -82,14 +108,8 @@ namespace Suspension
     void   write_probes();
     void   add_statistics_row(const Fluid::StepReport &r, const Fluid::FlowDiagnostics &d,
                               double dt, double wall_time);
-    void   add_solid_statistics(const Solid::SolidDiagnostics &d);
     void   update_contact_force();
-    void   add_contact_statistics();
-    void   report_contact() const;
     void   add_mesh_statistics(const MeshLevels &levels, bool adapted, double adapt_time);
-    /// 'Verification/Exact solid at probes': errors of phi and B there
-    void   report_solid_probes();
-    void   report_solid();
     double smallest_cell() const;
     void   report_errors(double time, bool steady);
     void   report_verdicts(bool steady);
@@ -112,12 +132,8 @@ namespace Suspension
     std::unique_ptr<Solid::SolidPhase<dim>>   solid;
     Solid::SolidDiagnostics                   solid_diagnostics;
     std::unique_ptr<Solid::ContactForce<dim>> contact;
-    Solid::ContactDiagnostics                 contact_diagnostics;
-    /// over the whole run: closest gaps, fewest and most particles seen
-    double                                    closest_gap_seen = -1., closest_wall_seen = -1.;
-    double                                    smallest_contact_cell = 0.;
-    unsigned int fewest_particles = std::numeric_limits<unsigned int>::max(), most_particles = 0;
-    double                                    phi_l1_error = -1., phi_cell_l1_error = -1.;
+    std::unique_ptr<Postprocess::ContactReport> contact_report;
+    std::unique_ptr<Postprocess::SolidReport<dim>> solid_report;
     Postprocess::FieldOutput<dim>             field_output;
     Postprocess::FlowVerification<dim>        verification;
     std::unique_ptr<Postprocess::ChannelStatistics<dim>> channel_statistics;
@@ -134,5 +150,10 @@ namespace Suspension
     unsigned int                              n_outputs              = 0;
     Checkpoint<dim>                           checkpoint;
     double wall_time_before = 0.; // of the run up to the checkpoint it resumed from
+    /// the step loop's state
+    std::vector<const Fluid::MomentumSource<dim> *> sources;
+    Fluid::FlowDiagnostics                          flow_diagnostics;
+    bool                                            steady = false;
+    std::chrono::steady_clock::time_point           run_start;
   };
 } // namespace Suspension
