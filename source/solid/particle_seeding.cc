@@ -1,4 +1,4 @@
-#include <suspension/core/particle_seeding.h>
+#include <suspension/solid/particle_seeding.h>
 
 #include <algorithm>
 #include <cmath>
