@@ -1,0 +1,380 @@
+// Simulation: what a run writes and prints (fields, probes, statistics.txt,
+// progress, errors and verdicts, the end-of-run summary).
+#include <deal.II/base/mpi.h>
+#include <deal.II/base/utilities.h>
+#include <deal.II/lac/solver_control.h>
+
+#include <suspension/core/memory.h>
+#include <suspension/core/simulation.h>
+#include <suspension/fluid/body_force.h>
+#include <suspension/mesh/resolution_check.h>
+#include <suspension/postprocess/cell_means.h>
+#include <suspension/postprocess/point_values.h>
+
+#include <chrono>
+#include <cmath>
+#include <fstream>
+#include <iomanip>
+#include <optional>
+#include <sstream>
+
+namespace Suspension
+{
+  namespace
+  {
+    std::string format_duration(const double seconds)
+    {
+      const long s = std::lround(std::max(0., seconds));
+      std::ostringstream out;
+      out << s / 3600 << "h" << std::setw(2) << std::setfill('0') << (s / 60) % 60 << "m"
+          << std::setw(2) << s % 60 << "s";
+      return out.str();
+    }
+  } // namespace
+
+  template <int dim>
+  void Simulation<dim>::add_mesh_statistics(const MeshLevels &levels, const bool adapted,
+                                            const double adapt_time)
+  {
+    // levels and counts of the mesh the step ran on; adapted: a new one
+    // for the next step
+    statistics.add_value("level_min", levels.min_level);
+    statistics.add_value("level_max", levels.max_level);
+    statistics.add_value("cells_finest", static_cast<unsigned long long>(levels.cells_on_finest));
+    if (solid)
+      statistics.add_value("coarse_interface_cells",
+                           static_cast<unsigned long long>(levels.coarse_interface_cells));
+    statistics.add_value("adapted", adapted ? 1 : 0);
+    statistics.add_value("wall_time_adapt", adapt_time);
+    statistics.set_scientific("wall_time_adapt", true);
+    statistics.set_precision("wall_time_adapt", 4);
+  }
+
+  template <int dim>
+  bool Simulation<dim>::output_due(const double time, const double dt) const
+  {
+    const auto &o = parameters.output;
+    if (o.interval_steps > 0 && fluid.step_number() % o.interval_steps == 0)
+      return true;
+    if (o.interval_time > 0 && time >= last_output_time + o.interval_time - 1e-9 * dt)
+      return true;
+    return false;
+  }
+
+  template <int dim>
+  void Simulation<dim>::write_output()
+  {
+    TimerOutput::Scope scope(timer, "output");
+    last_output_time = fluid.time();
+    if (parameters.output.write_vtu)
+      {
+        std::vector<Postprocess::ExtraField<dim>> extra;
+        if (solid)
+          extra.push_back({&solid->get_dof_handler(), &solid->get_solution(),
+                           solid->component_names()});
+        field_output.write(space, fluid.velocity(), fluid.kinematic_pressure(),
+                           parameters.material.density, fluid.time(), extra);
+      }
+    if (solid && parameters.output.write_phi_cells)
+      {
+        std::ostringstream name;
+        name << parameters.output.directory << "/phi_cells_" << std::setw(5) << std::setfill('0')
+             << n_outputs << ".txt";
+        Postprocess::write_cell_means(solid->get_dof_handler(), solid->get_solution(), 0, "phi",
+                                      fluid.time(), name.str());
+      }
+    ++n_outputs;
+    write_probes();
+  }
+
+  template <int dim>
+  void Simulation<dim>::write_probes()
+  {
+    const auto &coordinates = parameters.output.probe_points;
+    if (coordinates.empty())
+      return;
+    std::vector<Point<dim>> points;
+    for (const auto &c : coordinates)
+      {
+        Point<dim> p;
+        for (unsigned int d = 0; d < dim; ++d)
+          p[d] = c[d];
+        points.push_back(p);
+      }
+    const auto u = Postprocess::point_values(space.dof_velocity, fluid.velocity(), points);
+    const auto p = Postprocess::point_values(space.dof_pressure, fluid.kinematic_pressure(), points);
+    static const char *names[] = {"u_x", "u_y", "u_z"};
+    last_probe_values.clear();
+    for (unsigned int k = 0; k < points.size(); ++k)
+      {
+        std::ostringstream line;
+        line << "  probe " << k << " at (" << points[k] << "): u = (" << std::scientific
+             << std::setprecision(6);
+        for (unsigned int d = 0; d < dim; ++d)
+          line << (d > 0 ? ", " : "") << u[k][d];
+        line << "), p = " << parameters.material.density * p[k][0];
+        if (solid)
+          {
+            const auto names  = solid->component_names();
+            const auto values = solid->values_at({points[k]});
+            for (unsigned int c = 0; c < names.size(); ++c)
+              {
+                line << ", " << names[c] << " = " << values[0][c];
+                probes.add_value(names[c], values[0][c]);
+                probes.set_scientific(names[c], true);
+                probes.set_precision(names[c], 12);
+              }
+          }
+        last_probe_values.push_back(line.str());
+        probes.add_value("time", fluid.time());
+        probes.add_value("probe", k);
+        for (unsigned int d = 0; d < dim; ++d)
+          probes.add_value("x" + std::to_string(d), points[k][d]);
+        for (unsigned int d = 0; d < dim; ++d)
+          probes.add_value(names[d], u[k][d]);
+        probes.add_value("p", parameters.material.density * p[k][0]);
+      }
+  }
+
+  template <int dim>
+  void Simulation<dim>::add_statistics_row(const Fluid::StepReport      &r,
+                                           const Fluid::FlowDiagnostics &d,
+                                           const double                  dt,
+                                           const double                  wall_time)
+  {
+    statistics.add_value("step", fluid.step_number());
+    statistics.add_value("time", fluid.time());
+    statistics.add_value("dt", dt);
+    statistics.add_value("CFL", dt * d.max_speed_over_h);
+    statistics.add_value("bulk_velocity", d.bulk_velocity);
+    statistics.add_value("minus_dp_dx", r.driving_force);
+    statistics.add_value("kinetic_energy", d.kinetic_energy);
+    statistics.add_value("div_u_L2", d.divergence_l2);
+    statistics.add_value("its_momentum", r.momentum_iterations);
+    statistics.add_value("its_projection", r.projection_iterations);
+    statistics.add_value("its_mass", r.mass_iterations);
+    statistics.add_value("cells", triangulation.n_global_active_cells());
+    statistics.add_value("dofs", space.dof_velocity.n_dofs() + space.dof_pressure.n_dofs());
+    statistics.add_value("wall_time_step", wall_time);
+    for (const auto &c : {"time", "dt", "CFL", "bulk_velocity", "minus_dp_dx",
+                          "kinetic_energy", "div_u_L2", "wall_time_step"})
+      {
+        statistics.set_scientific(c, true);
+        statistics.set_precision(c, 8);
+      }
+  }
+
+  template <int dim>
+  void Simulation<dim>::write_tables() const
+  {
+    if (Utilities::MPI::this_mpi_process(communicator) != 0)
+      return;
+    std::ofstream stats(parameters.output.directory + "/statistics.txt");
+    statistics.write_text(stats, TableHandler::table_with_separate_column_description);
+    if (channel_statistics)
+      channel_statistics->write(parameters.output.directory);
+    if (!parameters.output.probe_points.empty())
+      {
+        std::ofstream out(parameters.output.directory + "/probes.txt");
+        TableHandler  copy = probes;
+        for (const auto &c : {"time", "x0", "x1", "x2", "u_x", "u_y", "u_z", "p"})
+          if (dim == 3 || (std::string(c) != "x2" && std::string(c) != "u_z"))
+            {
+              copy.set_scientific(c, true);
+              copy.set_precision(c, 10);
+            }
+        copy.write_text(out, TableHandler::table_with_separate_column_description);
+      }
+  }
+
+  template <int dim>
+  void Simulation<dim>::sample_statistics(const double driving_force)
+  {
+    TimerOutput::Scope scope(timer, "statistics");
+    std::optional<Postprocess::SolidFields<dim>> solid_fields;
+    if (solid)
+      solid_fields.emplace(Postprocess::SolidFields<dim>{
+        solid->get_dof_handler(), solid->get_solution(), parameters.solid.shear_modulus,
+        Solid::StressWeight(parameters.solid)});
+    channel_statistics->sample(space, fluid.velocity(), fluid.time(), driving_force,
+                               solid_fields ? &*solid_fields : nullptr,
+                               contact.get());
+  }
+
+  template <int dim>
+  void Simulation<dim>::report_errors(const double time, const bool steady)
+  {
+    if (!verification.has_exact_solution())
+      return;
+    last_errors = verification.errors(space, fluid.velocity(), fluid.kinematic_pressure(), time);
+    error_history.emplace_back(time, last_errors);
+    std::ostringstream when;
+    when << "t = " << std::setprecision(6) << time;
+    // the step at which a steady state is detected may differ by one
+    // between platforms or rank counts: do not print it
+    pcout << "  " << (steady ? std::string("steady state") : when.str())
+          << ": velocity L2 error " << std::scientific << std::setprecision(3)
+          << last_errors.velocity_l2 << " (relative " << last_errors.velocity_l2_relative
+          << "), pressure L2 error " << last_errors.pressure_l2 << std::defaultfloat
+          << std::endl;
+  }
+
+  template <int dim>
+  void Simulation<dim>::report_verdicts(const bool steady)
+  {
+    const double tolerance = parameters.verification.tolerance;
+    const auto   verdict   = [&](const double value) { return value <= tolerance ? "yes" : "no"; };
+    if (tolerance > 0 && verification.has_exact_solution())
+      pcout << "  velocity relative L2 error <= " << tolerance << ": "
+            << verdict(last_errors.velocity_l2_relative) << std::endl;
+
+    // In a channel at constant flow rate, -dp/dx over its laminar value
+    // 3 mu V_b / h^2 is the effective viscosity ratio.
+    const auto &driving = parameters.flow_driving;
+    if (parameters.geometry.type == Parameters::GeometryType::channel &&
+        driving.type == Parameters::FlowDrivingType::constant_flow_rate && steady)
+      {
+        const double h       = parameters.geometry.half_height;
+        const double laminar = 3. * parameters.material.viscosity * driving.bulk_velocity / (h * h);
+        const double ratio   = last_driving_force / laminar;
+        pcout << "  -dp/dx = " << std::setprecision(8) << last_driving_force
+              << ", laminar 3 mu V_b / h^2 = " << laminar << ", ratio " << ratio
+              << std::defaultfloat << std::endl;
+        if (tolerance > 0)
+          pcout << "  |ratio - 1| <= " << tolerance << ": " << verdict(std::abs(ratio - 1.))
+                << std::endl;
+      }
+  }
+
+  template <int dim>
+  void Simulation<dim>::print_progress(const double dt, const Fluid::FlowDiagnostics &d,
+                                       const double elapsed) const
+  {
+    const double t = fluid.time(), end = parameters.time_stepping.end_time;
+    pcout << "step " << std::setw(6) << fluid.step_number() << "  t = " << std::scientific
+          << std::setprecision(3) << t << " / " << end << "  dt = " << dt << "  CFL "
+          << std::fixed << std::setprecision(2) << dt * d.max_speed_over_h << "  ETA "
+          << format_duration(t > 0 ? elapsed / t * (end - t) : 0.) << std::defaultfloat
+          << std::endl;
+  }
+
+  template <int dim>
+  void Simulation<dim>::report_seeding() const
+  {
+    if (parameters.solid.seeded)
+      {
+        const auto &s = parameters.solid;
+        pcout << "  seeded " << s.particles.size() << " particles of radius " << s.seeding.radius
+              << ": volume fraction " << std::setprecision(6) << s.seeded_volume_fraction
+              << " (asked " << (s.seeding.n_particles > 0 ? "N = " : "Phi = ")
+              << (s.seeding.n_particles > 0 ? double(s.seeding.n_particles) :
+                                              s.seeding.volume_fraction)
+              << "), closest gap " << s.seeded_closest_gap << " (at least "
+              << s.seeding.minimum_gap << "), closest wall " << s.seeded_closest_wall
+              << " (at least " << s.seeding.wall_clearance << ")" << std::defaultfloat
+              << std::endl;
+        // Phi is met to half a particle's volume fraction (N is a whole number)
+        const double one = s.seeded_volume_fraction / s.particles.size();
+        const bool   as_asked =
+          s.seeding.n_particles > 0 ?
+            s.particles.size() == s.seeding.n_particles :
+            std::abs(s.seeded_volume_fraction - s.seeding.volume_fraction) <= 0.5 * one + 1e-12;
+        pcout << "  N and Phi as asked: " << (as_asked ? "yes" : "no")
+              << ", no overlap and wall clearance kept: "
+              << (s.seeded_closest_gap >= s.seeding.minimum_gap &&
+                      s.seeded_closest_wall >= s.seeding.wall_clearance ?
+                    "yes" :
+                    "no")
+              << std::endl;
+      }
+  }
+
+  /// The end of a run: the last output and every report.
+  template <int dim>
+  RunSummary Simulation<dim>::finish(const double dt)
+  {
+    const auto &diagnostics = flow_diagnostics;
+    if (steady)
+      pcout << "  steady state reached" << std::endl;
+    if (sampled_enough())
+      pcout << "  statistics complete: 'Statistics/Sampling time' of steady flow sampled by t = "
+            << fluid.time() << std::endl;
+    if (last_output_time != fluid.time())
+      write_output();
+    write_tables();
+
+    pcout << "  final state: kinetic energy " << std::scientific << std::setprecision(6)
+          << diagnostics.kinetic_energy;
+    if (parameters.flow_driving.type != Parameters::FlowDrivingType::none)
+      pcout << ", bulk velocity " << diagnostics.bulk_velocity << ", -dp/dx "
+            << last_driving_force;
+    pcout << std::defaultfloat << std::endl;
+    for (const auto &line : last_probe_values)
+      pcout << line << std::endl;
+    if (adaptor.enabled())
+      {
+        pcout << "  mesh: " << n_adaptations << " adaptations, now "
+              << triangulation.n_global_active_cells() << " cells";
+        if (solid)
+          pcout << "; interface cells below the finest level, most in any step: "
+                << worst_coarse_interface;
+        pcout << std::endl;
+      }
+    if (solid_report)
+      solid_report->report(pcout, solid_diagnostics, fluid.velocity(), fluid.time());
+    if (contact_report && pcout.is_active())
+      contact_report->report(pcout.get_stream());
+    report_errors(fluid.time(), steady);
+    report_verdicts(steady);
+    if (channel_statistics && pcout.is_active())
+      channel_statistics->print_summary(pcout.get_stream(), parameters.verification.tolerance,
+                                        !solid);
+    if (parameters.verification.reference_data == Parameters::ReferenceData::ghia_re100)
+      {
+        const auto c = verification.compare_with_ghia(space, fluid.velocity());
+        pcout << "  Ghia et al. (1982), Re = 100: max |u - u_ref| on x = 1/2: " << std::fixed
+              << std::setprecision(3) << c.max_u_deviation << ", max |v - v_ref| on y = 1/2: "
+              << c.max_v_deviation << std::defaultfloat << std::endl;
+        pcout << "  within 2% of the lid speed: "
+              << (std::max(c.max_u_deviation, c.max_v_deviation) <= 0.02 ? "yes" : "no")
+              << std::endl;
+      }
+
+    if (parameters.output.timer_summary)
+      pcout << "  "
+            << memory_line(space.dof_velocity.n_dofs(),
+                           estimate_memory(parameters, communicator).bytes_per_rank, communicator)
+            << std::endl;
+
+    RunSummary summary;
+    summary.final_errors = last_errors;
+    summary.errors       = error_history;
+    if (solid_report)
+      {
+        summary.phi_l1_error      = solid_report->phi_l1_error();
+        summary.phi_cell_l1_error = solid_report->phi_cell_l1_error();
+      }
+    summary.deformation_history = deformation_history;
+    if (solid && parameters.solid.particles.size() == 1)
+      {
+        const auto shape    = solid->particle_shape(space, fluid.velocity());
+        summary.deformation = shape.taylor_deformation;
+        summary.inclination = shape.inclination;
+        summary.deformation_B = shape.taylor_deformation_B;
+        summary.inclination_B = shape.inclination_B;
+      }
+    double h = std::numeric_limits<double>::max();
+    for (const auto &cell : triangulation.active_cell_iterators())
+      if (cell->is_locally_owned())
+        h = std::min(h, cell->minimum_vertex_distance());
+    summary.smallest_cell = Utilities::MPI::min(h, communicator);
+    summary.time_step     = dt;
+    summary.n_steps       = fluid.step_number();
+    summary.n_dofs        = space.dof_velocity.n_dofs() + space.dof_pressure.n_dofs();
+    summary.n_cells       = triangulation.n_global_active_cells();
+    return summary;
+  }
+
+  template class Simulation<2>;
+  template class Simulation<3>;
+} // namespace Suspension
