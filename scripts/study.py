@@ -106,7 +106,8 @@ def command(case):
 
 
 def finish(case, seconds):
-    """case_done.json: when it ended, what it cost, whether it was steady."""
+    """case_done.json: when it ended, what it cost (CPU seconds per rank x
+    ranks), whether it was steady."""
     d = directory(case)
     cpu = seconds * ranks
     previous = os.path.join(d, "cpu_seconds_before.txt")
@@ -207,18 +208,23 @@ try:
             break
         for name in list(running):
             case, proc, t0 = running[name]
-            if proc.poll() is None:
+            # wait4: the exit status and the CPU time the case used (user +
+            # system, its MPI ranks included), not its wall time
+            pid, status, usage = os.wait4(proc.pid, os.WNOHANG)
+            if pid == 0:
                 continue
+            proc.returncode = os.waitstatus_to_exitcode(status)
+            cpu = (usage.ru_utime + usage.ru_stime) / ranks
             del running[name]
             if proc.returncode == 0:
-                finish(case, time.time() - t0)
+                finish(case, cpu)
                 finished_now += 1
                 with open(os.path.join(directory(case), "case_done.json")) as f:
                     line = json.load(f)["stationarity"]
                 print(f"  done  {name}: {line}", flush=True)
                 collect()
             else:
-                spent_before(case, time.time() - t0)
+                spent_before(case, cpu)
                 failed.append(name)
                 with open(os.path.join(directory(case), "run.log")) as f:
                     last = [l for l in f.read().splitlines() if l.strip()][-1:]
@@ -240,8 +246,9 @@ try:
 except KeyboardInterrupt:
     for name, (case, proc, t0) in running.items():
         proc.terminate()
-        proc.wait()
-        spent_before(case, time.time() - t0)
+        _, _, usage = os.wait4(proc.pid, 0)
+        proc.returncode = -15
+        spent_before(case, (usage.ru_utime + usage.ru_stime) / ranks)
     print("study interrupted: run the same command again to resume", flush=True)
     sys.exit(130)
 
