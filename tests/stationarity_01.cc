@@ -13,7 +13,13 @@
 //    continuous means);
 // 4. a linear drift y = 1 + 0.1 t never counts as steady by t = 20;
 // 5. too short a series for its correlation: 64 samples of the AR(1)
-//    series are flagged as not converged.
+//    series are flagged as not converged;
+// 6. noise is not drift: y = 1 + 0.01 e (e independent, unit variance),
+//    sampled every 0.01 over windows of 1, tolerance 0.1 %: the two
+//    windows' means differ by about 0.01 sqrt(2/100) = 0.14 %, more than
+//    the tolerance, but within two standard errors (0.28 %): steady at the
+//    first comparison, t = 2; the same noise on a drift of 5 % per time
+//    unit is not steady by t = 20.
 
 #include <suspension/postprocess/stationarity.h>
 
@@ -107,6 +113,19 @@ int main()
   const auto short_series = blocked_error(std::vector<double>(ar.begin(), ar.begin() + 64));
   out << "64 samples of the AR(1) series: converged: " << (short_series.converged ? "yes" : "no")
       << std::endl;
+
+  SteadyStateDetector noisy(w, 0.001), noisy_drift(w, 0.001);
+  double              noisy_at = -1.;
+  for (unsigned int i = 0; i <= 2000; ++i)
+    {
+      const double e = normal(random);
+      if (noisy.add(i * dt, {1. + 0.01 * e}) && noisy_at < 0)
+        noisy_at = i * dt;
+      noisy_drift.add(i * dt, {1. + 0.05 * i * dt + 0.01 * e});
+    }
+  out << "noise alone: steady at t = " << noisy_at << " (the first comparison, t = 2: "
+      << (std::abs(noisy_at - 2.) < 1e-9 ? "yes" : "no") << "); noise on a drift: steady by t = 20: "
+      << (noisy_drift.steady() ? "yes" : "no") << std::endl;
 
   SteadyStateDetector drifting(w, tolerance);
   for (unsigned int i = 0; i <= 2000; ++i)

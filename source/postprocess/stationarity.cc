@@ -70,29 +70,41 @@ namespace Suspension::Postprocess
     values.push_back(sample);
     if (time - times.front() < 2. * window * (1. - 1e-9))
       return false;
-    // means over (t - 2w, t - w] and (t - w, t]
-    const std::size_t   n = sample.size();
-    std::vector<double> older(n, 0.), newer(n, 0.);
-    unsigned int        n_older = 0, n_newer = 0;
+    // the samples of (t - 2w, t - w] and (t - w, t], per monitored value
+    const std::size_t                n = sample.size();
+    std::vector<std::vector<double>> older(n), newer(n);
     for (std::size_t s = times.size(); s-- > 0;)
       {
         const double age = time - times[s];
         if (age >= 2. * window * (1. - 1e-9))
           break;
-        auto &sum = age < window * (1. - 1e-9) ? newer : older;
-        (age < window * (1. - 1e-9) ? n_newer : n_older) += 1;
+        auto &side = age < window * (1. - 1e-9) ? newer : older;
         for (std::size_t c = 0; c < n; ++c)
-          sum[c] += values[s][c];
+          side[c].push_back(values[s][c]);
       }
-    if (n_older == 0 || n_newer == 0)
+    if (older[0].empty() || newer[0].empty())
       return false;
+    const auto mean = [](const std::vector<double> &x) {
+      double sum = 0.;
+      for (const double v : x)
+        sum += v;
+      return sum / x.size();
+    };
     last_changes.assign(n, 0.);
+    last_allowed.assign(n, tolerance);
     bool within = true;
     for (std::size_t c = 0; c < n; ++c)
       {
-        const double a = older[c] / n_older, b = newer[c] / n_newer;
-        last_changes[c] = std::abs(b - a) / std::max(std::abs(b), 1e-300);
-        within          = within && last_changes[c] < tolerance;
+        // the samples are stored newest first: their order does not
+        // matter for the mean, and blocking sees the same neighbours
+        const double a = mean(older[c]), b = mean(newer[c]);
+        const double scale = std::max(std::abs(b), 1e-300);
+        last_changes[c]    = std::abs(b - a) / scale;
+        // a change the windows' own scatter explains is not a drift: two
+        // standard errors of the difference of two blocked means
+        const double ea = blocked_error(older[c]).error, eb = blocked_error(newer[c]).error;
+        last_allowed[c] = std::max(tolerance, 2. * std::sqrt(ea * ea + eb * eb) / scale);
+        within          = within && last_changes[c] < last_allowed[c];
       }
     if (!within)
       return false;
@@ -115,7 +127,11 @@ namespace Suspension::Postprocess
     const auto changes_text = [&]() {
       std::string text;
       for (std::size_t c = 0; c < last_changes.size() && c < names.size(); ++c)
-        text += (c > 0 ? ", " : "") + names[c] + " " + percent(last_changes[c]);
+        {
+          text += (c > 0 ? ", " : "") + names[c] + " " + percent(last_changes[c]);
+          if (c < last_allowed.size() && last_allowed[c] > tolerance)
+            text += " (within its noise, 2 sigma = " + percent(last_allowed[c]) + ")";
+        }
       return text;
     };
     if (!measured())
@@ -149,6 +165,8 @@ namespace Suspension::Postprocess
       }
     for (const double c : last_changes)
       out << c << " ";
+    for (const double c : last_allowed)
+      out << c << " ";
     out << "\n";
   }
 
@@ -169,6 +187,9 @@ namespace Suspension::Postprocess
       }
     last_changes.assign(n_changes, 0.);
     for (double &c : last_changes)
+      in >> c;
+    last_allowed.assign(n_changes, 0.);
+    for (double &c : last_allowed)
       in >> c;
     if (in.fail())
       throw std::runtime_error("channel statistics: cannot read the saved steady-state record");

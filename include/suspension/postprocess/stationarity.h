@@ -34,8 +34,11 @@ namespace Suspension::Postprocess
    * at every sample, the means over the last two windows of length
    * `window`, (t - 2w, t - w] and (t - w, t], are compared; the series is
    * steady at the first sample at which every mean changes by less than
-   * `tolerance` relative to the newer one. With window = 0 the detector
-   * is off and steady() is true from the first sample.
+   * `tolerance` relative to the newer one, or by less than the windows'
+   * own scatter explains (two standard errors of the difference of the
+   * two means, each by blocking): a change within the noise is not a
+   * drift. With window = 0 the detector is off and steady() is true from
+   * the first sample.
    */
   class SteadyStateDetector
   {
@@ -67,5 +70,7 @@ namespace Suspension::Postprocess
     bool                             is_steady = false;
     double                           t_steady  = 0.;
     std::vector<double>              last_changes;
+    /// the change each could make and count as steady: max(tolerance, 2 sigma)
+    std::vector<double>              last_allowed;
   };
 } // namespace Suspension::Postprocess
