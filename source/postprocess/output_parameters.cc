@@ -120,8 +120,10 @@ namespace Suspension::Parameters
                       "time' on, the samples' effective viscosity and the "
                       "solid's mean distance from the walls are averaged over "
                       "the last two windows of this length (time units); once "
-                      "both means change by less than 'Steady state "
-                      "tolerance' from one window to the next, the flow is "
+                      "each mean changes by less than 'Steady state "
+                      "tolerance' from one window to the next, or by less "
+                      "than two standard errors of the difference (the "
+                      "windows' own scatter, by blocking), the flow is "
                       "steady, the sums start again from that sample, and the "
                       "run prints the criterion with its result. A run that "
                       "ends before says so and calls its numbers provisional.");
