@@ -6,6 +6,7 @@
 #include <deal.II/lac/full_matrix.h>
 
 #include <suspension/postprocess/channel_statistics.h>
+#include <suspension/postprocess/channel_statistics_layout.h>
 
 #include <algorithm>
 #include <array>
@@ -19,50 +20,10 @@
 
 namespace Suspension::Postprocess
 {
+  using namespace ChannelLayout;
+
   namespace
   {
-    /// What a sample integrates per bin; the first n_stored are summed over
-    /// samples as the sample's bin means (uu..uv then hold the covariances
-    /// of the fluctuations, see fluctuations()). t = (y - y_bin) / (width/2).
-    enum Quantity : unsigned int
-    {
-      volume, // integral (not a mean): |bin|
-      y,
-      u,
-      v,
-      w,
-      uu,
-      vv,
-      ww,
-      uv,
-      phi,
-      viscous, // mu du/dy
-      elastic, // G phi B_xy
-      force_x, // contact force density
-      n_stored,
-      t1 = n_stored, // moments of t for the fit of the mean profile
-      t2,
-      t3,
-      t4,
-      ut1,
-      ut2,
-      vt1,
-      vt2,
-      wt1,
-      wt2,
-      n_integrated
-    };
-
-    enum Budget : unsigned int
-    {
-      b_viscous,
-      b_reynolds,
-      b_elastic,
-      b_collision,
-      b_total,
-      n_budget
-    };
-
     /// The covariances u'u', v'v', w'w', u'v' of one bin of one sample
     /// (bin integrals I), the fluctuations taken about the least-squares
     /// fit a + b t + c t^2 of each velocity component over the bin: its
@@ -113,11 +74,6 @@ namespace Suspension::Postprocess
     const double delta = x - mean;
     mean += delta / n;
     m2 += delta * (x - mean);
-  }
-
-  double RunningMean::error() const
-  {
-    return n > 1 ? std::sqrt(std::max(0., m2 / (n - 1)) / n) : 0.;
   }
 
   template <int dim>

@@ -31,15 +31,14 @@ namespace Suspension::Postprocess
     Solid::StressWeight                               weight; // stress G H(phi) (B - I)
   };
 
-  /// Mean and standard error over samples (Welford's update, stable
-  /// where the samples hardly differ).
+  /// Mean over samples (Welford's update, stable where the samples hardly
+  /// differ); the error of the mean is BlockedError's, from the series.
   struct RunningMean
   {
     unsigned long n    = 0;
     double        mean = 0., m2 = 0.;
 
-    void   add(double x);
-    double error() const; // sqrt(var / n), 0 with one sample
+    void add(double x);
   };
 
   /**
