@@ -43,8 +43,8 @@ namespace Suspension
     , space(triangulation, parameters.fluid_solver.velocity_degree,
             parameters.fluid_solver.pressure_degree)
     , fluid(parameters, scene, space, operators)
+    , verification_report(parameters, space)
     , field_output(parameters.output.directory)
-    , verification(parameters)
     , checkpoint(parameters, communicator)
   {
     fluid.set_timer(timer);
@@ -65,6 +65,10 @@ namespace Suspension
                                                              scene.upper_corner());
         contact_report = std::make_unique<Postprocess::ContactReport>(parameters);
       }
+    if (adaptor.enabled())
+      mesh_report = std::make_unique<Postprocess::MeshReport>(solid != nullptr);
+    if (!parameters.output.probe_points.empty())
+      probe_report = std::make_unique<Postprocess::ProbeReport<dim>>(parameters, space, solid.get());
     if (parameters.statistics.enabled)
       channel_statistics =
         std::make_unique<Postprocess::ChannelStatistics<dim>>(parameters, communicator);
@@ -121,7 +125,6 @@ namespace Suspension
     do
       change_mesh_with_fields();
     while (adaptor.flag_periodic_hanging_faces());
-    ++n_adaptations;
     return true;
   }
 
@@ -351,7 +354,6 @@ namespace Suspension
     if (!adaptor.enabled())
       return;
     const MeshLevels levels = adaptor.levels(solid.get());
-    worst_coarse_interface  = std::max(worst_coarse_interface, levels.coarse_interface_cells);
     bool       adapted      = false;
     const auto adapt_start  = std::chrono::steady_clock::now();
     if (adaptor.due(flow_diagnostics.max_speed * dt))
@@ -362,7 +364,7 @@ namespace Suspension
         if (solid)
           solid_diagnostics = solid->diagnostics();
       }
-    add_mesh_statistics(levels, adapted,
+    mesh_report->record(statistics, levels, adapted,
                         std::chrono::duration<double>(std::chrono::steady_clock::now() -
                                                       adapt_start)
                           .count());
@@ -374,16 +376,10 @@ namespace Suspension
     for (const double t : parameters.verification.report_times)
       if (std::abs(t - fluid.time()) < 1e-9 * dt)
         {
-          report_errors(fluid.time(), false);
+          verification_report.report_errors(pcout, fluid.velocity(), fluid.kinematic_pressure(),
+                                            fluid.time(), false);
           if (solid_report)
-            solid_report->report_probes(pcout, fluid.time());
-          if (solid && parameters.solid.particles.size() == 1)
-            {
-              const auto shape = solid->particle_shape(space, fluid.velocity());
-              deformation_history.push_back(
-                {fluid.time(), shape.taylor_deformation, shape.taylor_deformation_B});
-              pcout << "  t = " << fluid.time() << ": " << Postprocess::describe(shape) << std::endl;
-            }
+            solid_report->report_at(pcout, fluid.velocity(), fluid.time());
         }
   }
 

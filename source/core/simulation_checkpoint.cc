@@ -118,10 +118,6 @@ namespace Suspension
       object.save(out);
       return out.str();
     };
-    std::vector<double> errors; // time, then the FlowErrors, per report
-    for (const auto &[t, e] : error_history)
-      errors.insert(errors.end(), {t, e.velocity_l2, e.velocity_l2_relative, e.pressure_l2});
-
     // a line resume() reads before the mesh, then a boost archive
     std::ostringstream out;
     out << checkpoint_header() << "\n";
@@ -131,12 +127,12 @@ namespace Suspension
       archive << part(fluid) << (solid ? part(*solid) : std::string()) << part(adaptor)
               << part(field_output)
               << (channel_statistics ? part(*channel_statistics) : std::string());
-      const unsigned long long worst = worst_coarse_interface;
-      archive << dt << wall_time << last_output_time << last_driving_force << worst
-              << n_adaptations << n_outputs
-              << (contact_report ? part(*contact_report) : std::string()) << last_probe_values << errors << last_errors.velocity_l2
-              << last_errors.velocity_l2_relative << last_errors.pressure_l2;
-      archive << statistics << probes;
+      archive << dt << wall_time << last_output_time << last_driving_force << n_outputs
+              << (mesh_report ? part(*mesh_report) : std::string())
+              << (contact_report ? part(*contact_report) : std::string())
+              << (probe_report ? part(*probe_report) : std::string())
+              << part(verification_report);
+      archive << statistics;
     }
     return out.str();
   }
@@ -178,22 +174,18 @@ namespace Suspension
         part(*channel_statistics, statistics_state);
       }
 
-    double              dt = 0.;
-    unsigned long long  worst = 0;
-    std::vector<double> errors;
-    std::string         contact_state;
-    archive >> dt >> wall_time_before >> last_output_time >> last_driving_force >> worst >>
-      n_adaptations >> n_outputs >> contact_state >> last_probe_values >>
-      errors >> last_errors.velocity_l2 >> last_errors.velocity_l2_relative >>
-      last_errors.pressure_l2;
-    worst_coarse_interface = worst;
+    double      dt = 0.;
+    std::string mesh_state, contact_state, probe_state, verification_state;
+    archive >> dt >> wall_time_before >> last_output_time >> last_driving_force >> n_outputs >>
+      mesh_state >> contact_state >> probe_state >> verification_state;
+    if (mesh_report)
+      part(*mesh_report, mesh_state);
     if (contact_report)
       part(*contact_report, contact_state);
-    error_history.clear();
-    for (std::size_t i = 0; i + 3 < errors.size(); i += 4)
-      error_history.emplace_back(errors[i],
-                                 Postprocess::FlowErrors{errors[i + 1], errors[i + 2], errors[i + 3]});
-    archive >> statistics >> probes;
+    if (probe_report)
+      part(*probe_report, probe_state);
+    part(verification_report, verification_state);
+    archive >> statistics;
 
     std::ostringstream line;
     line << "  resumed from '" << path << "' (written on " << ranks << " rank"

@@ -9,7 +9,6 @@
 #include <suspension/fluid/body_force.h>
 #include <suspension/mesh/resolution_check.h>
 #include <suspension/postprocess/cell_means.h>
-#include <suspension/postprocess/point_values.h>
 
 #include <chrono>
 #include <cmath>
@@ -31,24 +30,6 @@ namespace Suspension
       return out.str();
     }
   } // namespace
-
-  template <int dim>
-  void Simulation<dim>::add_mesh_statistics(const MeshLevels &levels, const bool adapted,
-                                            const double adapt_time)
-  {
-    // levels and counts of the mesh the step ran on; adapted: a new one
-    // for the next step
-    statistics.add_value("level_min", levels.min_level);
-    statistics.add_value("level_max", levels.max_level);
-    statistics.add_value("cells_finest", static_cast<unsigned long long>(levels.cells_on_finest));
-    if (solid)
-      statistics.add_value("coarse_interface_cells",
-                           static_cast<unsigned long long>(levels.coarse_interface_cells));
-    statistics.add_value("adapted", adapted ? 1 : 0);
-    statistics.add_value("wall_time_adapt", adapt_time);
-    statistics.set_scientific("wall_time_adapt", true);
-    statistics.set_precision("wall_time_adapt", 4);
-  }
 
   template <int dim>
   bool Simulation<dim>::output_due(const double time, const double dt) const
@@ -84,56 +65,8 @@ namespace Suspension
                                       fluid.time(), name.str());
       }
     ++n_outputs;
-    write_probes();
-  }
-
-  template <int dim>
-  void Simulation<dim>::write_probes()
-  {
-    const auto &coordinates = parameters.output.probe_points;
-    if (coordinates.empty())
-      return;
-    std::vector<Point<dim>> points;
-    for (const auto &c : coordinates)
-      {
-        Point<dim> p;
-        for (unsigned int d = 0; d < dim; ++d)
-          p[d] = c[d];
-        points.push_back(p);
-      }
-    const auto u = Postprocess::point_values(space.dof_velocity, fluid.velocity(), points);
-    const auto p = Postprocess::point_values(space.dof_pressure, fluid.kinematic_pressure(), points);
-    static const char *names[] = {"u_x", "u_y", "u_z"};
-    last_probe_values.clear();
-    for (unsigned int k = 0; k < points.size(); ++k)
-      {
-        std::ostringstream line;
-        line << "  probe " << k << " at (" << points[k] << "): u = (" << std::scientific
-             << std::setprecision(6);
-        for (unsigned int d = 0; d < dim; ++d)
-          line << (d > 0 ? ", " : "") << u[k][d];
-        line << "), p = " << parameters.material.density * p[k][0];
-        if (solid)
-          {
-            const auto names  = solid->component_names();
-            const auto values = solid->values_at({points[k]});
-            for (unsigned int c = 0; c < names.size(); ++c)
-              {
-                line << ", " << names[c] << " = " << values[0][c];
-                probes.add_value(names[c], values[0][c]);
-                probes.set_scientific(names[c], true);
-                probes.set_precision(names[c], 12);
-              }
-          }
-        last_probe_values.push_back(line.str());
-        probes.add_value("time", fluid.time());
-        probes.add_value("probe", k);
-        for (unsigned int d = 0; d < dim; ++d)
-          probes.add_value("x" + std::to_string(d), points[k][d]);
-        for (unsigned int d = 0; d < dim; ++d)
-          probes.add_value(names[d], u[k][d]);
-        probes.add_value("p", parameters.material.density * p[k][0]);
-      }
+    if (probe_report)
+      probe_report->sample(fluid.velocity(), fluid.kinematic_pressure(), fluid.time());
   }
 
   template <int dim>
@@ -173,18 +106,8 @@ namespace Suspension
     statistics.write_text(stats, TableHandler::table_with_separate_column_description);
     if (channel_statistics)
       channel_statistics->write(parameters.output.directory);
-    if (!parameters.output.probe_points.empty())
-      {
-        std::ofstream out(parameters.output.directory + "/probes.txt");
-        TableHandler  copy = probes;
-        for (const auto &c : {"time", "x0", "x1", "x2", "u_x", "u_y", "u_z", "p"})
-          if (dim == 3 || (std::string(c) != "x2" && std::string(c) != "u_z"))
-            {
-              copy.set_scientific(c, true);
-              copy.set_precision(c, 10);
-            }
-        copy.write_text(out, TableHandler::table_with_separate_column_description);
-      }
+    if (probe_report)
+      probe_report->write(parameters.output.directory);
   }
 
   template <int dim>
@@ -199,51 +122,6 @@ namespace Suspension
     channel_statistics->sample(space, fluid.velocity(), fluid.time(), driving_force,
                                solid_fields ? &*solid_fields : nullptr,
                                contact.get());
-  }
-
-  template <int dim>
-  void Simulation<dim>::report_errors(const double time, const bool steady)
-  {
-    if (!verification.has_exact_solution())
-      return;
-    last_errors = verification.errors(space, fluid.velocity(), fluid.kinematic_pressure(), time);
-    error_history.emplace_back(time, last_errors);
-    std::ostringstream when;
-    when << "t = " << std::setprecision(6) << time;
-    // the step at which a steady state is detected may differ by one
-    // between platforms or rank counts: do not print it
-    pcout << "  " << (steady ? std::string("steady state") : when.str())
-          << ": velocity L2 error " << std::scientific << std::setprecision(3)
-          << last_errors.velocity_l2 << " (relative " << last_errors.velocity_l2_relative
-          << "), pressure L2 error " << last_errors.pressure_l2 << std::defaultfloat
-          << std::endl;
-  }
-
-  template <int dim>
-  void Simulation<dim>::report_verdicts(const bool steady)
-  {
-    const double tolerance = parameters.verification.tolerance;
-    const auto   verdict   = [&](const double value) { return value <= tolerance ? "yes" : "no"; };
-    if (tolerance > 0 && verification.has_exact_solution())
-      pcout << "  velocity relative L2 error <= " << tolerance << ": "
-            << verdict(last_errors.velocity_l2_relative) << std::endl;
-
-    // In a channel at constant flow rate, -dp/dx over its laminar value
-    // 3 mu V_b / h^2 is the effective viscosity ratio.
-    const auto &driving = parameters.flow_driving;
-    if (parameters.geometry.type == Parameters::GeometryType::channel &&
-        driving.type == Parameters::FlowDrivingType::constant_flow_rate && steady)
-      {
-        const double h       = parameters.geometry.half_height;
-        const double laminar = 3. * parameters.material.viscosity * driving.bulk_velocity / (h * h);
-        const double ratio   = last_driving_force / laminar;
-        pcout << "  -dp/dx = " << std::setprecision(8) << last_driving_force
-              << ", laminar 3 mu V_b / h^2 = " << laminar << ", ratio " << ratio
-              << std::defaultfloat << std::endl;
-        if (tolerance > 0)
-          pcout << "  |ratio - 1| <= " << tolerance << ": " << verdict(std::abs(ratio - 1.))
-                << std::endl;
-      }
   }
 
   template <int dim>
@@ -309,36 +187,25 @@ namespace Suspension
       pcout << ", bulk velocity " << diagnostics.bulk_velocity << ", -dp/dx "
             << last_driving_force;
     pcout << std::defaultfloat << std::endl;
-    for (const auto &line : last_probe_values)
-      pcout << line << std::endl;
-    if (adaptor.enabled())
+    if (probe_report && pcout.is_active())
+      probe_report->report(pcout.get_stream());
+    if (mesh_report)
       {
-        pcout << "  mesh: " << n_adaptations << " adaptations, now "
-              << triangulation.n_global_active_cells() << " cells";
-        if (solid)
-          pcout << "; interface cells below the finest level, most in any step: "
-                << worst_coarse_interface;
-        pcout << std::endl;
+        const auto n_cells = triangulation.n_global_active_cells();
+        if (pcout.is_active())
+          mesh_report->report(pcout.get_stream(), n_cells);
       }
     if (solid_report)
       solid_report->report(pcout, solid_diagnostics, fluid.velocity(), fluid.time());
     if (contact_report && pcout.is_active())
       contact_report->report(pcout.get_stream());
-    report_errors(fluid.time(), steady);
-    report_verdicts(steady);
+    verification_report.report_errors(pcout, fluid.velocity(), fluid.kinematic_pressure(),
+                                      fluid.time(), steady);
+    verification_report.report_verdicts(pcout, fluid.velocity(), last_driving_force, steady);
     if (channel_statistics && pcout.is_active())
       channel_statistics->print_summary(pcout.get_stream(), parameters.verification.tolerance,
                                         !solid);
-    if (parameters.verification.reference_data == Parameters::ReferenceData::ghia_re100)
-      {
-        const auto c = verification.compare_with_ghia(space, fluid.velocity());
-        pcout << "  Ghia et al. (1982), Re = 100: max |u - u_ref| on x = 1/2: " << std::fixed
-              << std::setprecision(3) << c.max_u_deviation << ", max |v - v_ref| on y = 1/2: "
-              << c.max_v_deviation << std::defaultfloat << std::endl;
-        pcout << "  within 2% of the lid speed: "
-              << (std::max(c.max_u_deviation, c.max_v_deviation) <= 0.02 ? "yes" : "no")
-              << std::endl;
-      }
+    verification_report.report_reference(pcout, fluid.velocity());
 
     if (parameters.output.timer_summary)
       pcout << "  "
@@ -347,14 +214,14 @@ namespace Suspension
             << std::endl;
 
     RunSummary summary;
-    summary.final_errors = last_errors;
-    summary.errors       = error_history;
+    summary.final_errors = verification_report.last_errors();
+    summary.errors       = verification_report.history();
     if (solid_report)
       {
-        summary.phi_l1_error      = solid_report->phi_l1_error();
-        summary.phi_cell_l1_error = solid_report->phi_cell_l1_error();
+        summary.phi_l1_error        = solid_report->phi_l1_error();
+        summary.phi_cell_l1_error   = solid_report->phi_cell_l1_error();
+        summary.deformation_history = solid_report->deformation_history();
       }
-    summary.deformation_history = deformation_history;
     if (solid && parameters.solid.particles.size() == 1)
       {
         const auto shape    = solid->particle_shape(space, fluid.velocity());

@@ -92,6 +92,19 @@ namespace Suspension::Postprocess
   }
 
   template <int dim>
+  void SolidReport<dim>::report_at(const ConditionalOStream &out,
+                                   const Fluid::VectorType  &velocity, const double time)
+  {
+    report_probes(out, time);
+    if (parameters.solid.particles.size() == 1)
+      {
+        const auto shape = solid.particle_shape(space, velocity);
+        shapes.push_back({{time, shape.taylor_deformation, shape.taylor_deformation_B}});
+        out << "  t = " << time << ": " << describe(shape) << std::endl;
+      }
+  }
+
+  template <int dim>
   void SolidReport<dim>::report_probes(const ConditionalOStream &out, const double time) const
   {
     const auto &v = parameters.verification;

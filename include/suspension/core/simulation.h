@@ -20,6 +20,9 @@
 #include <suspension/postprocess/solid_report.h>
 #include <suspension/postprocess/field_output.h>
 #include <suspension/postprocess/flow_verification.h>
+#include <suspension/postprocess/mesh_report.h>
+#include <suspension/postprocess/probe_report.h>
+#include <suspension/postprocess/verification_report.h>
 #include <suspension/solid/contact_force.h>
 #include <suspension/solid/solid_phase.h>
 
@@ -105,14 +108,10 @@ namespace Suspension
     double choose_time_step(double dt, double time, const Fluid::FlowDiagnostics &d) const;
     bool   output_due(double time, double dt) const;
     void   write_output();
-    void   write_probes();
     void   add_statistics_row(const Fluid::StepReport &r, const Fluid::FlowDiagnostics &d,
                               double dt, double wall_time);
     void   update_contact_force();
-    void   add_mesh_statistics(const MeshLevels &levels, bool adapted, double adapt_time);
     double smallest_cell() const;
-    void   report_errors(double time, bool steady);
-    void   report_verdicts(bool steady);
     void   print_progress(double dt, const Fluid::FlowDiagnostics &d, double elapsed) const;
     void   write_tables() const;
     void   sample_statistics(double driving_force);
@@ -134,20 +133,16 @@ namespace Suspension
     std::unique_ptr<Solid::ContactForce<dim>> contact;
     std::unique_ptr<Postprocess::ContactReport> contact_report;
     std::unique_ptr<Postprocess::SolidReport<dim>> solid_report;
+    std::unique_ptr<Postprocess::MeshReport>  mesh_report;
+    std::unique_ptr<Postprocess::ProbeReport<dim>> probe_report;
+    Postprocess::VerificationReport<dim>      verification_report;
     Postprocess::FieldOutput<dim>             field_output;
-    Postprocess::FlowVerification<dim>        verification;
     std::unique_ptr<Postprocess::ChannelStatistics<dim>> channel_statistics;
-    TableHandler                              statistics, probes;
-    Postprocess::FlowErrors                   last_errors;
-    std::vector<std::pair<double, Postprocess::FlowErrors>> error_history;
-    std::vector<std::array<double, 3>>                        deformation_history;
-    std::vector<std::string>                  last_probe_values;
+    TableHandler                              statistics;
     double                                    smallest_cell_size = 0.; // per mesh
     double                                    last_output_time   = 0.;
     double                                    last_driving_force = 0.;
-    types::global_cell_index                  worst_coarse_interface = 0; // over all steps
-    unsigned int                              n_adaptations          = 0;
-    unsigned int                              n_outputs              = 0;
+    unsigned int                              n_outputs          = 0;
     Checkpoint<dim>                           checkpoint;
     double wall_time_before = 0.; // of the run up to the checkpoint it resumed from
     /// the step loop's state

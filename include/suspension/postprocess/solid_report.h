@@ -7,8 +7,10 @@
 #include <suspension/fluid/fluid_space.h>
 #include <suspension/solid/solid_phase.h>
 
+#include <array>
 #include <iosfwd>
 #include <string>
+#include <vector>
 
 namespace Suspension::Postprocess
 {
@@ -42,6 +44,11 @@ namespace Suspension::Postprocess
     /// 'Verification/Exact solid at probes': errors of phi and B there
     void report_probes(const ConditionalOStream &out, double time) const;
 
+    /// at a 'Verification/Report time': the probe errors and, with one
+    /// particle, its shape (kept in deformation_history())
+    void report_at(const ConditionalOStream &out, const Fluid::VectorType &velocity,
+                   double time);
+
     /// the end of the run; computes the phi errors of an exact fraction
     void report(const ConditionalOStream &out, const Solid::SolidDiagnostics &d,
                 const Fluid::VectorType &velocity, double time);
@@ -49,11 +56,14 @@ namespace Suspension::Postprocess
     /// < 0: no exact fraction given
     double phi_l1_error() const { return l1_error; }
     double phi_cell_l1_error() const { return cell_l1_error; }
+    /// (t, D, D_B) of the single particle at the report times
+    const std::vector<std::array<double, 3>> &deformation_history() const { return shapes; }
 
   private:
     const Parameters::All        &parameters;
     const Solid::SolidPhase<dim> &solid;
     const Fluid::FluidSpace<dim> &space;
     double                        l1_error = -1., cell_l1_error = -1.;
+    std::vector<std::array<double, 3>> shapes;
   };
 } // namespace Suspension::Postprocess
