@@ -201,7 +201,7 @@ namespace Suspension
       contact_report->report(pcout.get_stream());
     verification_report.report_errors(pcout, fluid.velocity(), fluid.kinematic_pressure(),
                                       fluid.time(), steady);
-    verification_report.report_verdicts(pcout, fluid.velocity(), last_driving_force, steady);
+    verification_report.report_verdicts(pcout, last_driving_force, steady);
     if (channel_statistics && pcout.is_active())
       channel_statistics->print_summary(pcout.get_stream(), parameters.verification.tolerance,
                                         !solid);

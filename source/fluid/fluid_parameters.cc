@@ -2,7 +2,7 @@
 #include <deal.II/base/utilities.h>
 
 #include <suspension/core/parameter_parsing.h>
-#include <suspension/core/parameters.h>
+#include <suspension/fluid/fluid_parameters.h>
 
 namespace Suspension::Parameters
 {

@@ -39,7 +39,6 @@ namespace Suspension::Postprocess
 
   template <int dim>
   void VerificationReport<dim>::report_verdicts(const ConditionalOStream &out,
-                                                const Fluid::VectorType  &velocity,
                                                 const double driving_force, const bool steady) const
   {
     const double tolerance = parameters.verification.tolerance;

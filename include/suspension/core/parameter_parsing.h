@@ -1,6 +1,6 @@
 #pragma once
 
-#include <suspension/core/parameters.h>
+#include <suspension/core/parameter_basics.h>
 
 #include <string>
 #include <vector>

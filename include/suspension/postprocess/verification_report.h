@@ -33,8 +33,7 @@ namespace Suspension::Postprocess
     void report_errors(const ConditionalOStream &out, const Fluid::VectorType &velocity,
                        const Fluid::VectorType &kinematic_pressure, double time, bool steady);
     /// the verdicts and reference comparisons of the end of a run
-    void report_verdicts(const ConditionalOStream &out, const Fluid::VectorType &velocity,
-                         double driving_force, bool steady) const;
+    void report_verdicts(const ConditionalOStream &out, double driving_force, bool steady) const;
     /// 'Verification/Reference data': the deviation from the tabulated flow
     void report_reference(const ConditionalOStream &out, const Fluid::VectorType &velocity) const;
 

@@ -1,6 +1,6 @@
 #pragma once
 
-#include <suspension/core/parameters.h>
+#include <suspension/solid/solid_parameters.h>
 
 #include <algorithm>
 
