@@ -27,6 +27,7 @@
 #include <fstream>
 #include <iomanip>
 #include <random>
+#include <string>
 #include <vector>
 
 using namespace Suspension::Postprocess;
@@ -126,6 +127,12 @@ int main()
   out << "noise alone: steady at t = " << noisy_at << " (the first comparison, t = 2: "
       << (std::abs(noisy_at - 2.) < 1e-9 ? "yes" : "no") << "); noise on a drift: steady by t = 20: "
       << (noisy_drift.steady() ? "yes" : "no") << std::endl;
+  // the verdict names a change beyond the noise allowance as such
+  const std::string drift_text = noisy_drift.describe({"y"}, 20.);
+  out << "noise on a drift, verdict says above its noise: "
+      << (drift_text.find("above its noise") != std::string::npos ? "yes" : "no")
+      << ", within its noise: "
+      << (drift_text.find("within its noise") != std::string::npos ? "yes" : "no") << std::endl;
 
   SteadyStateDetector drifting(w, tolerance);
   for (unsigned int i = 0; i <= 2000; ++i)

@@ -130,7 +130,8 @@ namespace Suspension::Postprocess
         {
           text += (c > 0 ? ", " : "") + names[c] + " " + percent(last_changes[c]);
           if (c < last_allowed.size() && last_allowed[c] > tolerance)
-            text += " (within its noise, 2 sigma = " + percent(last_allowed[c]) + ")";
+            text += std::string(last_changes[c] < last_allowed[c] ? " (within" : " (above") +
+                    " its noise, 2 sigma = " + percent(last_allowed[c]) + ")";
         }
       return text;
     };
