@@ -269,7 +269,7 @@ namespace Suspension::Solid
     const double speed = ((2. * k + 1.) * (1. + c) +
                           2. * dim * 2. * (k + 1.) * (k + 1.) * parameters.solid.interface_thickness * c) *
                          speed_over_h / k_u;
-    return parameters.solid.transport_cfl / speed;
+    return (parameters.solid.rk2 ? 0.8 : 1.) * parameters.solid.transport_cfl / speed;
   }
 
   template <int dim>
@@ -320,24 +320,41 @@ namespace Suspension::Solid
     };
 
     // The boundary flux of each stage, with the weight the stage has in
-    // the step: y1 = y0 + h L0, y2 = (3 y0 + y1 + h L1) / 4,
-    // y3 = (y0 + 2 y2 + 2 h L2) / 3 = y0 + h (L0 / 6 + L1 / 6 + 2 L2 / 3).
+    // the step: SSP-RK3 y1 = y0 + h L0, y2 = (3 y0 + y1 + h L1) / 4,
+    // y3 = (y0 + 2 y2 + 2 h L2) / 3 = y0 + h (L0 / 6 + L1 / 6 + 2 L2 / 3);
+    // SSP-RK2 y1 = y0 + h L0, y2 = (y0 + y1 + h L1) / 2 = y0 + h (L0 + L1) / 2.
     // The limiter keeps cell means, so int phi changes only by these.
-    double outflow = 0., flux = 0.;
+    const bool rk2     = parameters.solid.rk2;
+    double     outflow = 0., flux = 0.;
     for (unsigned int s = 0; s < n_sub; ++s)
       {
         const double f = s * h / dt;
         // B where the sub-step can carry solid (elsewhere it stays I)
         transport.mark_solid_cells(solution);
-        // SSP-RK3: stages at t, t + h, t + h/2
+        // SSP-RK3: stages at t, t + h, t + h/2; SSP-RK2: at t, t + h
         velocity_at(f);
         solution.zero_out_ghost_values();
         flux = 0.;
         transport.apply(solution, stage_rhs, u_stage, &flux);
-        outflow += h / 6. * flux;
+        outflow += (rk2 ? h / 2. : h / 6.) * flux;
         stage.equ(1., solution);
         stage.add(h, stage_rhs);
         limit(stage);
+
+        if (rk2)
+          {
+            velocity_at(f + h / dt);
+            flux = 0.;
+            transport.apply(stage, stage_rhs, u_stage, &flux);
+            outflow += h / 2. * flux;
+            stage.add(h, stage_rhs);
+            // y0 / 2 + z / 2 as z + (y0 - z) / 2 (exact halves): int phi
+            // moves by the boundary flux only
+            solution.add(-1., stage);
+            solution.sadd(0.5, 1., stage);
+            limit(solution);
+            continue;
+          }
 
         velocity_at(f + h / dt);
         flux = 0.;

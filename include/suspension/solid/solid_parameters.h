@@ -32,6 +32,9 @@ namespace Suspension::Parameters
     unsigned int                     degree        = 1;
     bool                             limiter       = true;
     double                           transport_cfl = 0.5;
+    /// SSP-RK3 (3 stages per sub-step) or SSP-RK2 (2; DG 1 only, sub-steps
+    /// at 0.8 of the limit)
+    bool                             rk2 = false;
     double                           elastic_number = 0.5;
     /// semi-implicit: the stress increment dt G phi (grad u B + B grad u^T),
     /// linear in the new velocity, goes into the momentum predictor
