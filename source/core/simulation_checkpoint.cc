@@ -45,9 +45,13 @@ namespace Suspension
       return result;
     };
     const std::string saved = state.substr(0, state.find('\n'));
-    if (saved.rfind("suspension-checkpoint 1 ", 0) != 0)
+    // format 2 (session 14): the reports (mesh, probes, verification)
+    // save their own parts
+    if (saved.rfind("suspension-checkpoint 2 ", 0) != 0)
       throw std::runtime_error("--resume: '" + path + "/state.txt' is not a checkpoint of "
-                               "this version of suspension");
+                               "this version of suspension (format 2; '" +
+                               saved.substr(0, saved.find(' ', saved.find(' ') + 1)) +
+                               "' was written by an older one): rerun the case from its start");
     if (without_ranks(saved) != without_ranks(checkpoint_header()))
       throw std::runtime_error("--resume: the checkpoint in '" + path + "' was written for '" +
                                without_ranks(saved) + "', the parameter file gives '" +
@@ -103,7 +107,7 @@ namespace Suspension
   std::string Simulation<dim>::checkpoint_header() const
   {
     std::ostringstream line;
-    line << "suspension-checkpoint 1 " << dim << "D " << Utilities::MPI::n_mpi_processes(communicator)
+    line << "suspension-checkpoint 2 " << dim << "D " << Utilities::MPI::n_mpi_processes(communicator)
          << " " << triangulation.n_cells(0) << "_coarse_cells " << space.fe_velocity.get_name()
          << " " << space.fe_pressure.get_name() << " "
          << (solid ? solid->get_fe().get_name() : std::string("no_solid"));

@@ -36,6 +36,12 @@ expect missing_file       "$dir/no_such_file.prm"      -- "no_such_file.prm" "ca
 expect too_dense          "$dir/too_dense.prm"         -- "too_dense.prm" "Solid/Seeding/Volume fraction" "could place only"
 expect statistics_box     "$dir/statistics_not_channel.prm" -- "statistics_not_channel.prm" "Statistics/Enabled" "channel"
 expect no_checkpoint       "$dir/../checkpoint_restart/scene.prm" --resume -- "no checkpoint" "output_files/checkpoint"
+# a checkpoint of an older format (before the reports saved their own parts)
+mkdir -p output_files/checkpoint
+echo "suspension-checkpoint 1 2D 1 8_coarse_cells FESystem[FE_Q<2>(2)^2] FE_Q<2>(1) no_solid" \
+  > output_files/checkpoint/state.txt
+expect old_checkpoint     "$dir/../checkpoint_restart/scene.prm" --resume -- "not a checkpoint of this version" "format 2" "rerun the case"
+rm -rf output_files
 expect bad_option         "$dir/../checkpoint_restart/scene.prm" --resum -- "unknown or incomplete option" "--resum"
 expect no_argument                                     -- "no parameter file"
 expect empty_file         "$dir/empty.prm"             -- "empty.prm" "sets no entry"
