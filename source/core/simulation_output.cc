@@ -189,12 +189,8 @@ namespace Suspension
     pcout << std::defaultfloat << std::endl;
     if (probe_report && pcout.is_active())
       probe_report->report(pcout.get_stream());
-    if (mesh_report)
-      {
-        const auto n_cells = triangulation.n_global_active_cells();
-        if (pcout.is_active())
-          mesh_report->report(pcout.get_stream(), n_cells);
-      }
+    if (mesh_report && pcout.is_active())
+      mesh_report->report(pcout.get_stream(), triangulation.n_global_active_cells());
     if (solid_report)
       solid_report->report(pcout, solid_diagnostics, fluid.velocity(), fluid.time());
     if (contact_report && pcout.is_active())
