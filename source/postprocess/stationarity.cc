@@ -141,7 +141,7 @@ namespace Suspension::Postprocess
     if (is_steady)
       s << "steady from t = " << t_steady << ": the means over the last two windows of "
         << window << " changed by " << changes_text() << " (tolerance " << percent(tolerance)
-        << "); sampled over " << last_time - t_steady << " time units since";
+        << "); sampled over " << last_time - t_steady << " time units since then";
     else if (last_changes.empty())
       s << "NOT STEADY: fewer than two windows of " << window
         << " time units of samples by t = " << last_time << "; the numbers are provisional";
