@@ -50,14 +50,14 @@ namespace Suspension::Postprocess
         line << "), p = " << rho * p[k][0];
         if (solid)
           {
-            const auto names  = solid->component_names();
+            const auto fields = solid->component_names();
             const auto values = solid->values_at({points[k]});
-            for (unsigned int c = 0; c < names.size(); ++c)
+            for (unsigned int c = 0; c < fields.size(); ++c)
               {
-                line << ", " << names[c] << " = " << values[0][c];
-                table.add_value(names[c], values[0][c]);
-                table.set_scientific(names[c], true);
-                table.set_precision(names[c], 12);
+                line << ", " << fields[c] << " = " << values[0][c];
+                table.add_value(fields[c], values[0][c]);
+                table.set_scientific(fields[c], true);
+                table.set_precision(fields[c], 12);
               }
           }
         last_lines.push_back(line.str());

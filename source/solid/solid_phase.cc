@@ -341,13 +341,13 @@ namespace Suspension::Solid
         stage.add(h, stage_rhs);
         limit(stage);
 
+        velocity_at(f + h / dt);
+        flux = 0.;
+        transport.apply(stage, stage_rhs, u_stage, &flux);
+        outflow += (rk2 ? h / 2. : h / 6.) * flux;
+        stage.add(h, stage_rhs);
         if (rk2)
           {
-            velocity_at(f + h / dt);
-            flux = 0.;
-            transport.apply(stage, stage_rhs, u_stage, &flux);
-            outflow += h / 2. * flux;
-            stage.add(h, stage_rhs);
             // y0 / 2 + z / 2 as z + (y0 - z) / 2 (exact halves): int phi
             // moves by the boundary flux only
             solution.add(-1., stage);
@@ -355,12 +355,6 @@ namespace Suspension::Solid
             limit(solution);
             continue;
           }
-
-        velocity_at(f + h / dt);
-        flux = 0.;
-        transport.apply(stage, stage_rhs, u_stage, &flux);
-        outflow += h / 6. * flux;
-        stage.add(h, stage_rhs);
         stage.sadd(0.25, 0.75, solution);
         limit(stage);
 

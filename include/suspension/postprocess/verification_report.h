@@ -37,7 +37,8 @@ namespace Suspension::Postprocess
     /// 'Verification/Reference data': the deviation from the tabulated flow
     void report_reference(const ConditionalOStream &out, const Fluid::VectorType &velocity) const;
 
-    const FlowErrors &last_errors() const { return last; }
+    /// the last errors reported (zero before the first)
+    FlowErrors last_errors() const { return errors.empty() ? FlowErrors() : errors.back().second; }
     const std::vector<std::pair<double, FlowErrors>> &history() const { return errors; }
 
     void save(std::ostream &out) const;
@@ -47,7 +48,6 @@ namespace Suspension::Postprocess
     const Parameters::All                     &parameters;
     const Fluid::FluidSpace<dim>              &space;
     FlowVerification<dim>                      verification;
-    FlowErrors                                 last;
     std::vector<std::pair<double, FlowErrors>> errors;
   };
 } // namespace Suspension::Postprocess
