@@ -13,15 +13,37 @@
 
 namespace Suspension::Fluid
 {
+  void copy_locally_owned(const VectorType &from, LinearAlgebra::distributed::Vector<double> &to)
+  {
+    AssertDimension(from.locally_owned_size(), to.locally_owned_size());
+    const PetscScalar *values;
+    AssertThrow(VecGetArrayRead(from, &values) == 0, ExcMessage("VecGetArrayRead"));
+    std::copy(values, values + to.locally_owned_size(), to.begin());
+    AssertThrow(VecRestoreArrayRead(from, &values) == 0, ExcMessage("VecRestoreArrayRead"));
+  }
+
+  void copy_locally_owned(const LinearAlgebra::distributed::Vector<double> &from, VectorType &to)
+  {
+    AssertDimension(from.locally_owned_size(), to.locally_owned_size());
+    PetscScalar *values;
+    AssertThrow(VecGetArray(to, &values) == 0, ExcMessage("VecGetArray"));
+    std::copy(from.begin(), from.begin() + from.locally_owned_size(), values);
+    AssertThrow(VecRestoreArray(to, &values) == 0, ExcMessage("VecRestoreArray"));
+  }
+
   template <int dim>
   void MomentumOperator<dim>::reinit(const FluidSpace<dim> &space)
   {
     degree = space.fe_velocity.degree;
     typename MatrixFree<dim, double>::AdditionalData data;
     data.tasks_parallel_scheme = MatrixFree<dim, double>::AdditionalData::none;
-    data.mapping_update_flags  = update_values | update_gradients | update_JxW_values;
-    matrix_free.reinit(MappingQ1<dim>(), space.dof_velocity, space.velocity_constraints,
-                       QGauss<1>(degree + 1), data);
+    // quadrature points: the right-hand side evaluates its sources there
+    data.mapping_update_flags =
+      update_values | update_gradients | update_JxW_values | update_quadrature_points;
+    const std::vector<const DoFHandler<dim> *> dofs = {&space.dof_velocity, &space.dof_pressure};
+    const std::vector<const AffineConstraints<double> *> constraints = {
+      &space.velocity_constraints, &space.pressure_constraints};
+    matrix_free.reinit(MappingQ1<dim>(), dofs, constraints, QGauss<1>(degree + 1), data);
     matrix_free.initialize_dof_vector(x_local);
     matrix_free.initialize_dof_vector(b_local);
     // every constrained DoF (Dirichlet, hanging, periodic) is left out of
@@ -117,17 +139,8 @@ namespace Suspension::Fluid
   unsigned int MomentumOperator<dim>::solve(VectorType &x, const VectorType &b,
                                             const double tolerance) const
   {
-    // in: the locally owned entries, contiguous and in the same order in
-    // both kinds of vector (the DoFHandler's locally owned range)
-    const auto copy_in = [](const VectorType &from, Vector &to) {
-      const PetscScalar *values;
-      AssertThrow(VecGetArrayRead(from, &values) == 0, ExcMessage("VecGetArrayRead"));
-      std::copy(values, values + to.locally_owned_size(), to.begin());
-      AssertThrow(VecRestoreArrayRead(from, &values) == 0, ExcMessage("VecRestoreArrayRead"));
-    };
-    AssertDimension(b.locally_owned_size(), b_local.locally_owned_size());
-    copy_in(b, b_local);
-    copy_in(x, x_local);
+    copy_locally_owned(b, b_local);
+    copy_locally_owned(x, x_local);
     for (const unsigned int i : constrained)
       b_local.local_element(i) = x_local.local_element(i) = 0.;
 
@@ -142,11 +155,7 @@ namespace Suspension::Fluid
         cg.solve(*this, x_local, b_local, inverse_diagonal);
         iterations = control.last_step();
       }
-    // out
-    PetscScalar *values;
-    AssertThrow(VecGetArray(x, &values) == 0, ExcMessage("VecGetArray"));
-    std::copy(x_local.begin(), x_local.begin() + x_local.locally_owned_size(), values);
-    AssertThrow(VecRestoreArray(x, &values) == 0, ExcMessage("VecRestoreArray"));
+    copy_locally_owned(x_local, x);
     return iterations;
   }
 

@@ -35,6 +35,7 @@ namespace Suspension::Fluid
       v->reinit(space.owned_velocity, space.relevant_velocity, comm);
     for (auto *v : {&pressure_ghosted, &p_sharp_ghosted})
       v->reinit(space.owned_pressure, space.relevant_pressure, comm);
+    matrix_free_rhs_ready = false;
   }
 
   template <int dim>
@@ -408,6 +409,32 @@ namespace Suspension::Fluid
     const double dt, const double t_new,
     const std::vector<const MomentumSource<dim> *> &sources)
   {
+    const bool convection =
+      parameters.fluid_solver.convection != Parameters::ConvectionForm::none;
+    bool any_stress = false;
+    for (const auto *s : sources)
+      any_stress = any_stress || s->has_stress();
+
+    if (operators.matrix_free_momentum && !operators.step_matrix)
+      {
+        if (!matrix_free_rhs_ready)
+          matrix_free_rhs.reinit(operators.momentum_operator);
+        matrix_free_rhs_ready = true;
+        MomentumLoad<dim> load;
+        load.history         = &u_history_ghosted;
+        load.u_star          = &u_star_ghosted;
+        load.p_sharp         = &p_sharp_ghosted;
+        load.sources         = &sources;
+        load.time            = t_new;
+        load.alpha_over_dt   = operators.momentum_alpha_over_dt;
+        load.viscosity       = nu;
+        load.inverse_density = 1. / parameters.material.density;
+        load.convection      = convection;
+        load.stress          = any_stress;
+        matrix_free_rhs.assemble(operators.momentum_operator, space, step_constraints, load, rhs_u);
+        return;
+      }
+
     rhs_u = 0.;
     // Semi-implicit elastic coupling: the stress increment of the velocity
     // correction du = u^{n+1} - u*, theta dt G phi (grad du B + B grad du^T),
@@ -419,11 +446,6 @@ namespace Suspension::Fluid
     const double theta         = 0.5;
     if (semi_implicit)
       operators.A_step = 0.;
-    const bool convection =
-      parameters.fluid_solver.convection != Parameters::ConvectionForm::none;
-    bool any_stress = false;
-    for (const auto *s : sources)
-      any_stress = any_stress || s->has_stress();
 
     const FEValuesExtractors::Vector velocities(0);
     FEValues<dim> fe_u(space.fe_velocity, space.quadrature,

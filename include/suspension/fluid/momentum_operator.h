@@ -25,6 +25,12 @@ namespace Suspension::Fluid
    */
   using VectorType = LinearAlgebraPETSc::MPI::Vector;
 
+  /// The locally owned entries of a PETSc vector into a deal.II one (or
+  /// back) on the same DoFs: contiguous and in the same order in both
+  /// (the DoFHandler's locally owned range; MatrixFree does not renumber).
+  void copy_locally_owned(const VectorType &from, LinearAlgebra::distributed::Vector<double> &to);
+  void copy_locally_owned(const LinearAlgebra::distributed::Vector<double> &from, VectorType &to);
+
   template <int dim>
   class MomentumOperator
   {
@@ -46,6 +52,13 @@ namespace Suspension::Fluid
     /// distributes the constraints afterwards, as for the assembled A).
     /// Returns the CG iterations.
     unsigned int solve(VectorType &x, const VectorType &b, double tolerance) const;
+
+    /// The cell data, shared with the matrix-free right-hand side: the
+    /// velocity DoFs (homogeneous constraints) and the pressure DoFs, one
+    /// Gauss quadrature of velocity degree + 1 points per direction.
+    const MatrixFree<dim, double> &get_matrix_free() const { return matrix_free; }
+    unsigned int velocity_degree() const { return degree; }
+    static constexpr unsigned int velocity_index = 0, pressure_index = 1;
 
   private:
     template <int degree, int n_q>

@@ -4,6 +4,7 @@
 #include <suspension/core/scene.h>
 #include <suspension/fluid/fluid_operators.h>
 #include <suspension/fluid/fluid_space.h>
+#include <suspension/fluid/momentum_right_hand_side.h>
 #include <suspension/fluid/momentum_source.h>
 
 #include <deal.II/base/timer.h>
@@ -138,6 +139,13 @@ namespace Suspension::Fluid
     TimerOutput           *timer = nullptr;
 
     AffineConstraints<double> step_constraints; // with boundary data at t^{n+1}
+
+    /// The right-hand side in a matrix-free loop (with the matrix-free
+    /// momentum operator, without the semi-implicit step matrix, whose
+    /// cell matrices the assembled loop builds anyway); its vectors are
+    /// set up on first use after a mesh change.
+    MomentumRightHandSide<dim> matrix_free_rhs;
+    bool                       matrix_free_rhs_ready = false;
 
     // time levels (owned) and ghosted views for cell loops
     VectorType u, u_old, u_older, unit_response;
