@@ -98,7 +98,10 @@ def run(exe, name, ranks, prm, sets, label):
     start = time.perf_counter()
     with open(os.path.join(out, "log"), "w") as log:
         sh(["/usr/bin/time", "-f", "%M", "-o", os.path.join(out, "rss")] + cmd,
-           stdout=log, stderr=subprocess.STDOUT, env=MPI_ENV, cwd=out)
+           stdout=log, stderr=subprocess.STDOUT, cwd=out,
+           # the library next to the executable: the RUNPATH would load the
+           # one in build/, which a rebuild meanwhile changes
+           env=dict(MPI_ENV, LD_LIBRARY_PATH=os.path.dirname(exe)))
     wall = time.perf_counter() - start
     text = open(os.path.join(out, "log")).read()
     row = {"scene": name, "code": label, "ranks": ranks, "wall_s": round(wall, 2),

@@ -95,7 +95,10 @@ namespace Suspension::Fluid
   {
     communicator = space.communicator();
     if (matrix_free_momentum)
-      momentum_operator.reinit(space);
+      {
+        momentum_operator.reinit(space);
+        divergence_operator.reinit(momentum_operator);
+      }
     else
       make_matrices({&M, &K, &A}, space.dof_velocity, space.owned_velocity,
                     space.relevant_velocity, space.velocity_constraints, true);
@@ -109,23 +112,24 @@ namespace Suspension::Fluid
 
     // D: pressure rows condensed, velocity columns kept as they are.
     const AffineConstraints<double> no_constraints;
-    {
-      DynamicSparsityPattern dsp(space.dof_pressure.n_dofs(),
-                                 space.dof_velocity.n_dofs(),
-                                 space.relevant_pressure);
-      std::vector<types::global_dof_index> p_dofs(space.fe_pressure.n_dofs_per_cell());
-      std::vector<types::global_dof_index> u_dofs(space.fe_velocity.n_dofs_per_cell());
-      for (const auto &cell : space.dof_velocity.active_cell_iterators())
-        if (cell->is_locally_owned())
-          {
-            cell->get_dof_indices(u_dofs);
-            FluidSpace<dim>::cell_of(cell, space.dof_pressure)->get_dof_indices(p_dofs);
-            space.pressure_constraints.add_entries_local_to_global(p_dofs, no_constraints, u_dofs, dsp, false);
-          }
-      SparsityTools::distribute_sparsity_pattern(dsp, space.owned_pressure, communicator,
-                                                 space.relevant_pressure);
-      D.reinit(space.owned_pressure, space.owned_velocity, dsp, communicator);
-    }
+    if (!matrix_free_momentum)
+      {
+        DynamicSparsityPattern dsp(space.dof_pressure.n_dofs(),
+                                   space.dof_velocity.n_dofs(),
+                                   space.relevant_pressure);
+        std::vector<types::global_dof_index> p_dofs(space.fe_pressure.n_dofs_per_cell());
+        std::vector<types::global_dof_index> u_dofs(space.fe_velocity.n_dofs_per_cell());
+        for (const auto &cell : space.dof_velocity.active_cell_iterators())
+          if (cell->is_locally_owned())
+            {
+              cell->get_dof_indices(u_dofs);
+              FluidSpace<dim>::cell_of(cell, space.dof_pressure)->get_dof_indices(p_dofs);
+              space.pressure_constraints.add_entries_local_to_global(p_dofs, no_constraints, u_dofs, dsp, false);
+            }
+        SparsityTools::distribute_sparsity_pattern(dsp, space.owned_pressure, communicator,
+                                                   space.relevant_pressure);
+        D.reinit(space.owned_pressure, space.owned_velocity, dsp, communicator);
+      }
 
     flux_weights.reinit(space.owned_velocity, communicator);
     unit_force.reinit(space.owned_velocity, communicator);
@@ -173,8 +177,9 @@ namespace Suspension::Fluid
                       cell_flux(i) += vi * JxW;
                       cell_force(i) += vi * JxW;
                     }
-                  for (unsigned int k = 0; k < np; ++k)
-                    cell_D(k, i) += fe_p.shape_value(k, q) * gi[ci] * JxW;
+                  if (!matrix_free_momentum)
+                    for (unsigned int k = 0; k < np; ++k)
+                      cell_D(k, i) += fe_p.shape_value(k, q) * gi[ci] * JxW;
                 }
               for (unsigned int k = 0; k < np; ++k)
                 for (unsigned int l = 0; l < np; ++l)
@@ -194,7 +199,9 @@ namespace Suspension::Fluid
           flux_weights.add(u_dofs, cell_flux);
           space.increment_constraints.distribute_local_to_global(cell_L, p_dofs, L);
           space.pressure_constraints.distribute_local_to_global(cell_Mp, p_dofs, Mp);
-          space.pressure_constraints.distribute_local_to_global(cell_D, p_dofs, no_constraints, u_dofs, D);
+          if (!matrix_free_momentum)
+            space.pressure_constraints.distribute_local_to_global(cell_D, p_dofs, no_constraints,
+                                                                  u_dofs, D);
         }
     for (auto *m : {&M, &K, &L, &Mp, &D})
       if (m->m() > 0)
@@ -279,6 +286,15 @@ namespace Suspension::Fluid
                                                         const double tolerance) const
   {
     return cg_solve(Mp, x, b, *jacobi_mass, tolerance, communicator);
+  }
+
+  template <int dim>
+  void FluidOperators<dim>::apply_divergence(const VectorType &u, VectorType &load)
+  {
+    if (matrix_free_momentum)
+      divergence_operator.apply(momentum_operator, u, load);
+    else
+      D.vmult(load, u);
   }
 
   template class FluidOperators<2>;

@@ -345,7 +345,7 @@ namespace Suspension::Fluid
 
     // 3. projection: the increment psi
     section.next("fluid: projection");
-    operators.D.vmult(div_u_load, u);
+    operators.apply_divergence(u, div_u_load);
     rhs_p = div_u_load;
     rhs_p *= -alpha / dt;
     space.increment_constraints.set_zero(rhs_p);

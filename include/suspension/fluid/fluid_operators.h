@@ -4,6 +4,7 @@
 #include <deal.II/lac/petsc_precondition.h>
 #include <deal.II/lac/petsc_solver.h>
 
+#include <suspension/fluid/divergence_operator.h>
 #include <suspension/fluid/fluid_space.h>
 #include <suspension/fluid/momentum_operator.h>
 
@@ -23,7 +24,8 @@ namespace Suspension::Fluid
    *   pressure  L (Laplacian, increment constraints), Mp (mass),
    *   D         (div v_j, q_i): pressure rows (condensed), velocity columns
    *             (not condensed, so D u is exact for any u with its boundary
-   *             values),
+   *             values); with the matrix-free momentum operator applied
+   *             matrix-free instead (DivergenceOperator),
    *   flux      m_x . u = integral of u_x, and b_x = (e_x, v) condensed,
    *             the load of a unit streamwise force.
    *
@@ -54,6 +56,10 @@ namespace Suspension::Fluid
     unsigned int solve_pressure_laplace(VectorType &x, const VectorType &b, double tolerance) const;
     unsigned int solve_pressure_mass(VectorType &x, const VectorType &b, double tolerance) const;
 
+    /// load = D u, (div u, q_i): matrix-free with the matrix-free momentum
+    /// operator, else with the assembled D.
+    void apply_divergence(const VectorType &u, VectorType &load);
+
     MatrixType M, K, A, L, Mp, D;
     MatrixType A_step; // only with 'step_matrix'
     /// Allocate A_step (semi-implicit elastic coupling).
@@ -67,6 +73,7 @@ namespace Suspension::Fluid
     /// the Jacobi preconditioner of its matrix-free diagonal).
     bool matrix_free_momentum = false;
     MomentumOperator<dim> momentum_operator;
+    DivergenceOperator<dim> divergence_operator;
 
   private:
     MPI_Comm                                             communicator;
