@@ -15,6 +15,12 @@ with a checkpoint/ continues from it (--resume); the others start afresh.
 Ctrl-C or a time limit loses at most the work since each case's last
 checkpoint ('Checkpoint/Interval minutes').
 
+Extendable: a case that stopped at its End time before its statistics were
+complete keeps the checkpoint the solver writes there; run the study again
+with a later End time (--set 'Time stepping/End time=T') and such cases go
+on from where they stopped (their CPU seconds carried over), while cases
+whose statistics were complete are skipped.
+
 While it runs, one line every 30 s: cases done, running (with their
 times), and the ETA of the whole study from the simulated time per
 second so far. At the end (and after every finished case) the study's
@@ -66,7 +72,16 @@ def directory(case):
 
 
 def done(case):
-    return os.path.isfile(os.path.join(directory(case), "case_done.json"))
+    """Finished, and not to be extended: a case that stopped at an End time
+    below the study's present one keeps its checkpoint and goes on."""
+    if not os.path.isfile(os.path.join(directory(case), "case_done.json")):
+        return False
+    return not extendable(case)
+
+
+def extendable(case):
+    has_checkpoint = os.path.isdir(os.path.join(directory(case), "checkpoint"))
+    return has_checkpoint and end_of(case) < end_time * (1. - 1e-9)
 
 
 def simulated_time(case):
@@ -123,8 +138,28 @@ def finish(case, seconds):
               "ranks": ranks, "stationarity": line}
     with open(os.path.join(d, "case_done.json"), "w") as f:
         json.dump(record, f, indent=1)
-    if os.path.isdir(os.path.join(d, "checkpoint")):
-        shutil.rmtree(os.path.join(d, "checkpoint"))  # done: not needed
+    # a case that stopped at its End time keeps its last checkpoint (the
+    # solver writes one there): a later End time extends it; one whose
+    # statistics were complete before that has no use for it
+    if record["time"] < end_time * (1. - 1e-9) and \
+            os.path.isdir(os.path.join(d, "checkpoint")):
+        shutil.rmtree(os.path.join(d, "checkpoint"))
+    for name in ["cpu_seconds_before.txt"]:
+        if os.path.isfile(os.path.join(d, name)):
+            os.remove(os.path.join(d, name))
+
+
+def extend(case):
+    """A finished case goes on from its last checkpoint to the present End
+    time: what it cost so far is carried over, its record is removed until
+    it finishes again (an interruption then resumes it as any case)."""
+    d = directory(case)
+    with open(os.path.join(d, "case_done.json")) as f:
+        record = json.load(f)
+    with open(os.path.join(d, "cpu_seconds_before.txt"), "w") as f:
+        f.write(str(record["cpu_seconds"]))
+    os.remove(os.path.join(d, "case_done.json"))
+    print(f"  extend {case['name']} from t = {record['time']:g} to {end_time:g}", flush=True)
 
 
 def spent_before(case, seconds):
@@ -196,6 +231,8 @@ try:
         while (pending and len(running) < jobs and
                (a.max_cases == 0 or finished_now + len(running) < a.max_cases)):
             case = pending.pop(0)
+            if os.path.isfile(os.path.join(directory(case), "case_done.json")):
+                extend(case)
             os.makedirs(directory(case), exist_ok=True)
             log = open(os.path.join(directory(case), "run.log"), "a")
             cmd = command(case)

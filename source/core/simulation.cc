@@ -435,6 +435,12 @@ namespace Suspension
             report_at_times(dt);
             write_if_due(dt); // output, progress, checkpoint
           }
+        // a run that reached its End time before its statistics were
+        // complete can go on to a later one (--resume with a larger End
+        // time, as scripts/study extends a case): its last state is kept
+        if (checkpoint.enabled() && !sampled_enough() &&
+            fluid.time() >= parameters.time_stepping.end_time * (1. - 1e-12))
+          write_checkpoint(dt, elapsed());
       }
     catch (const SolverControl::NoConvergence &e)
       {

@@ -9,7 +9,11 @@
 #    written a checkpoint; run again, it resumes that case from it;
 # 3. --max-cases 1 finishes that one case only; run again, it skips it and
 #    runs the second; a third run has nothing left to do;
-# 4. study.csv holds both cases with the verdict of their stationarity.
+# 4. study.csv holds both cases with the verdict of their stationarity;
+# 5. extension: a case that never becomes steady (tolerance 1e-9) stops at
+#    End time 0.1 with its last checkpoint; run again with End time 0.15,
+#    it goes on from t = 0.1 (not from t = 0), its CPU seconds carried over,
+#    and ends at 0.15; a run with End time 0.15 again has nothing to do.
 # usage: check.sh SUSPENSION SOURCE_DIRECTORY
 exe="$1"; src="$2"
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
@@ -72,3 +76,41 @@ for f in mu_eff.png normal_stresses.png profiles.png budget.png; do
   [ -s study/$f ] || fail "study/$f not written"
 done
 echo "figures written: yes"
+
+# 5: extending a finished, unsteady case to a later End time
+extend() {
+  exec /usr/bin/python3 "$src/scripts/study.py" "$src/parameters/study_2d_paper.prm" --exe "$exe" \
+    --jobs 1 --progress-seconds 1000 \
+    --set 'Study/Cases=grid' --set 'Study/Reynolds numbers=7.5' \
+    --set 'Study/Capillary numbers=0.15' --set 'Study/Volume fractions=0.025' \
+    --set "Study/Directory=extended" \
+    --set 'Mesh refinement/Maximum level=3' \
+    --set 'Statistics/Start time=0.02' --set 'Statistics/Steady state window=0.02' \
+    --set 'Statistics/Steady state tolerance=1e-9' --set 'Statistics/Sampling time=0.05' \
+    --set 'Checkpoint/Interval minutes=10' \
+    --set 'Output/Interval time=1' --set 'Output/Write phi cells=false' "$@"
+}
+case=extended/Re7.5_Ca0.15_Phi0.025
+(extend --set 'Time stepping/End time=0.1') > fifth.txt 2>&1 || { cat fifth.txt; fail "run to 0.1"; }
+[ -d "$case/checkpoint" ] || fail "the unsteady case kept no checkpoint at its End time"
+t1=$(/usr/bin/python3 -c "import json; print(json.load(open('$case/case_done.json'))['time'])")
+cpu1=$(/usr/bin/python3 -c "import json; print(json.load(open('$case/case_done.json'))['cpu_seconds'])")
+echo "stopped at t = $t1, NOT STEADY: $(grep -c 'NOT STEADY' $case/case_done.json), checkpoint kept: yes"
+(extend --set 'Time stepping/End time=0.15') > sixth.txt 2>&1 || { cat sixth.txt; fail "extension"; }
+grep "^  extend" sixth.txt
+grep -q "resumed from" "$case/run.log" || fail "the extension did not resume from the checkpoint"
+/usr/bin/python3 - "$case/case_done.json" "$case/statistics.txt" "$cpu1" <<'PY' || fail "extension record"
+import json, sys
+record = json.load(open(sys.argv[1]))
+times = [float(l.split()[1]) for l in open(sys.argv[2]) if not l.startswith("#")]
+steps = [int(l.split()[0]) for l in open(sys.argv[2]) if not l.startswith("#")]
+print(f"extended to t = {record['time']:.2f}; statistics.txt from t = {times[0]:.4f} to "
+      f"{times[-1]:.2f}, steps increasing: {'yes' if steps == sorted(set(steps)) else 'no'}; "
+      f"CPU carried over: {'yes' if record['cpu_seconds'] > float(sys.argv[3]) else 'no'}")
+sys.exit(0 if abs(record["time"] - 0.15) < 1e-3 and steps == sorted(set(steps))
+         and record["cpu_seconds"] > float(sys.argv[3]) else 1)
+PY
+(extend --set 'Time stepping/End time=0.15') > seventh.txt 2>&1 || { cat seventh.txt; fail "seventh run"; }
+grep -q "^  start\|^  extend" seventh.txt && fail "a finished case ran again"
+grep "study:" seventh.txt | tail -1
+
