@@ -26,7 +26,9 @@ times), and the ETA of the whole study from the simulated time per
 second so far. At the end (and after every finished case) the study's
 table Study/Directory/study.csv and its figures (scripts/plot_study.py).
 --max-cases K stops after K cases have finished in this invocation (a
-test of resumption).
+test of resumption). --collect only writes the table and the figures from
+the cases finished so far (for example while a part of the study runs
+under --set 'Study/Volume fractions=...').
 """
 import argparse
 import csv
@@ -49,6 +51,8 @@ p.add_argument("--max-cases", type=int, default=0)
 p.add_argument("--exe", default=os.path.join(here, "..", "build", "suspension"))
 p.add_argument("--set", action="append", default=[], dest="sets")
 p.add_argument("--progress-seconds", type=float, default=30.)
+p.add_argument("--collect", action="store_true",
+               help="write study.csv and the figures from the finished cases; run nothing")
 a = p.parse_args()
 
 overrides = []
@@ -217,6 +221,11 @@ def terminated(signum, frame):
 
 
 signal.signal(signal.SIGTERM, terminated)
+if a.collect:
+    collect()
+    print(f"study: {sum(done(c) for c in cases)}/{len(cases)} cases done in {root} (collected)",
+          flush=True)
+    sys.exit(0)
 pending = [c for c in cases if not done(c)]
 print(f"study {a.prm}: {len(cases)} cases, {len(cases) - len(pending)} done, "
       f"{len(pending)} to run, {jobs} at a time on {ranks} rank(s) each -> {root}",

@@ -63,7 +63,11 @@ grep -q "^  start Re7.5_Ca0.15_Phi0.025" third.txt && fail "the finished case ra
 grep "study:" fourth.txt
 grep -q "^  start" fourth.txt && fail "a finished case ran again"
 
-# 4: the table
+# 4: the table, also written by --collect without running anything
+rm study/study.csv
+(study --collect) > collect.txt 2>&1 || { cat collect.txt; fail "--collect"; }
+grep -q "^  start" collect.txt && fail "--collect ran a case"
+grep "collected" collect.txt
 /usr/bin/python3 - study/study.csv <<'PY'
 import csv, sys
 rows = list(csv.DictReader(open(sys.argv[1])))
