@@ -71,10 +71,12 @@ namespace Suspension::Fluid
     FEEvaluation<dim, pressure_degree, n_q, 1, double> pressure(mf, op.pressure_index);
     const unsigned int n_points = test.n_q_points;
     AssertDimension(n_points, unit_points.size());
-    std::vector<Point<dim>>               points(n_points);
-    std::vector<std::vector<Tensor<1, dim>>>          force(VA::size(), std::vector<Tensor<1, dim>>(n_points));
-    std::vector<std::vector<SymmetricTensor<2, dim>>> stress(VA::size(),
-                                                             std::vector<SymmetricTensor<2, dim>>(n_points));
+    // per lane of a cell batch: the sources' force and stress at the points
+    std::vector<Point<dim>>                           points(n_points);
+    std::vector<std::vector<Tensor<1, dim>>>          force(VA::size(),
+                                                   std::vector<Tensor<1, dim>>(n_points));
+    std::vector<std::vector<SymmetricTensor<2, dim>>> stress(
+      VA::size(), std::vector<SymmetricTensor<2, dim>>(n_points));
 
     const auto worker = [&](const MatrixFree<dim, double> &, Vector &dst, const Vector &,
                             const std::pair<unsigned int, unsigned int> &range) {

@@ -67,7 +67,7 @@ namespace Suspension::Fluid
   private:
     template <int degree, int n_q>
     void cell_loop(const MomentumOperator<dim> &op, const FluidSpace<dim> &space,
-                   const MomentumLoad<dim> &load, bool lifting);
+                   const MomentumLoad<dim> &load, bool lifted);
 
     using Vector = LinearAlgebra::distributed::Vector<double>;
     Vector history, u_star, lifting, p_sharp, result;
