@@ -19,18 +19,21 @@ exe="$1"; src="$2"
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
 cd "$work" || exit 1
 fail() { echo "FAILED: $*"; exit 1; }
+# the shipped study scene on tiny cases (Re = 7.5, Ca = 0.15, level 3);
 # always called in a subshell, ( study ... ): exec makes $! the driver itself
-study() {
+driver() {
   exec /usr/bin/python3 "$src/scripts/study.py" "$src/parameters/study_2d_paper.prm" --exe "$exe" \
     --jobs 1 --progress-seconds 1000 \
     --set 'Study/Cases=grid' --set 'Study/Reynolds numbers=7.5' \
-    --set 'Study/Capillary numbers=0.15' --set 'Study/Volume fractions=0.025, 0.05' \
-    --set "Study/Directory=study" \
-    --set 'Mesh refinement/Maximum level=3' --set 'Time stepping/End time=0.3' \
+    --set 'Study/Capillary numbers=0.15' --set 'Mesh refinement/Maximum level=3' \
+    --set 'Output/Interval time=1' --set 'Output/Write phi cells=false' "$@"
+}
+study() {
+  driver --set 'Study/Volume fractions=0.025, 0.05' --set "Study/Directory=study" \
+    --set 'Time stepping/End time=0.3' \
     --set 'Statistics/Start time=0.05' --set 'Statistics/Steady state window=0.05' \
     --set 'Statistics/Steady state tolerance=0.05' --set 'Statistics/Sampling time=0.05' \
-    --set 'Checkpoint/Interval minutes=0' --set 'Checkpoint/Interval steps=20' \
-    --set 'Output/Interval time=1' --set 'Output/Write phi cells=false' "$@"
+    --set 'Checkpoint/Interval minutes=0' --set 'Checkpoint/Interval steps=20' "$@"
 }
 one=study/Re7.5_Ca0.15_Phi0.025; two=study/Re7.5_Ca0.15_Phi0.05
 
@@ -83,16 +86,10 @@ echo "figures written: yes"
 
 # 5: extending a finished, unsteady case to a later End time
 extend() {
-  exec /usr/bin/python3 "$src/scripts/study.py" "$src/parameters/study_2d_paper.prm" --exe "$exe" \
-    --jobs 1 --progress-seconds 1000 \
-    --set 'Study/Cases=grid' --set 'Study/Reynolds numbers=7.5' \
-    --set 'Study/Capillary numbers=0.15' --set 'Study/Volume fractions=0.025' \
-    --set "Study/Directory=extended" \
-    --set 'Mesh refinement/Maximum level=3' \
+  driver --set 'Study/Volume fractions=0.025' --set "Study/Directory=extended" \
     --set 'Statistics/Start time=0.02' --set 'Statistics/Steady state window=0.02' \
     --set 'Statistics/Steady state tolerance=1e-9' --set 'Statistics/Sampling time=0.05' \
-    --set 'Checkpoint/Interval minutes=10' \
-    --set 'Output/Interval time=1' --set 'Output/Write phi cells=false' "$@"
+    --set 'Checkpoint/Interval minutes=10' "$@"
 }
 case=extended/Re7.5_Ca0.15_Phi0.025
 (extend --set 'Time stepping/End time=0.1') > fifth.txt 2>&1 || { cat fifth.txt; fail "run to 0.1"; }
