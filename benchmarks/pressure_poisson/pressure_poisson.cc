@@ -5,10 +5,15 @@
 //    Laplacian (hanging-node and periodicity constraints, one DoF pinned),
 //    CG preconditioned with BoomerAMG (strong threshold 0.25 in 2D, 0.5 in
 //    3D, as source/fluid/fluid_operators.cc);
-//  - gmg: no matrix, MatrixFreeOperators::LaplaceOperator on every level,
-//    geometric multigrid with local smoothing (float levels, Chebyshev of
-//    degree 4 around a Jacobi diagonal, CG to 1e-4 on level 0), the singular Neumann/periodic system solved with a mean-free
-//    right-hand side.
+//  - gmg local: no matrix, MatrixFreeOperators::LaplaceOperator on every
+//    level, geometric multigrid with local smoothing (MGTransferMatrixFree;
+//    float levels, Chebyshev of degree 4 around a Jacobi diagonal, CG to
+//    1e-4 on level 0), the singular Neumann/periodic system solved with a
+//    mean-free right-hand side;
+//  - gmg global: the same operators and smoothers with global coarsening
+//    (MGTransferGlobalCoarsening: each level an active mesh of its own, the
+//    fine one coarsened, with its own hanging-node and periodicity
+//    constraints).
 //
 // The mesh is made as the solver's adaptivity makes it at t = 0: a channel
 // periodic in the streamwise (and spanwise) directions with walls normal to
@@ -20,7 +25,7 @@
 //
 // Usage: pressure_poisson DIM MAX_LEVEL [N_SOLVES]
 // prints one line per method: set-up s, solve s (mean of N_SOLVES),
-// iterations, memory of the operator data.
+// iterations, the heap memory its set-up holds.
 
 #include <deal.II/base/conditional_ostream.h>
 #include <deal.II/base/function.h>
@@ -55,8 +60,11 @@
 #include <deal.II/multigrid/mg_matrix.h>
 #include <deal.II/multigrid/mg_smoother.h>
 #include <deal.II/multigrid/mg_tools.h>
+#include <deal.II/multigrid/mg_transfer_global_coarsening.h>
 #include <deal.II/multigrid/mg_transfer_matrix_free.h>
 #include <deal.II/multigrid/multigrid.h>
+
+#include <malloc.h>
 
 #include <fstream>
 #include <iomanip>
@@ -71,15 +79,13 @@ namespace
   constexpr double tolerance = 1e-8;
   constexpr double radius    = 0.1;
 
-  /// resident memory of this process now, MB (VmRSS)
-  double resident_mb()
+  /// heap memory in use by this process now, MB (glibc's mallinfo2: the
+  /// bytes allocated and not freed, PETSc's and hypre's included), so that
+  /// what one method frees is not counted again for the next
+  double heap_mb()
   {
-    std::ifstream status("/proc/self/status");
-    std::string   line;
-    while (std::getline(status, line))
-      if (line.rfind("VmRSS:", 0) == 0)
-        return std::stod(line.substr(6)) / 1024.;
-    return 0.;
+    const struct mallinfo2 info = mallinfo2();
+    return (info.uordblks + info.hblkhd) / 1e6;
   }
 
   template <int dim>
@@ -230,6 +236,7 @@ namespace
     void make_mesh();
     void run_amg();
     void run_gmg();
+    void run_gmg_global();
 
     MPI_Comm                                  communicator;
     ConditionalOStream                        pcout;
@@ -307,7 +314,7 @@ namespace
   template <int dim>
   void Benchmark<dim>::run_amg()
   {
-    const double memory_before = resident_mb();
+    const double memory_before = heap_mb();
     Timer        timer(communicator, true);
 
     // the solver's pinned DoF: the first owned one of rank 0
@@ -381,7 +388,7 @@ namespace
         iterations = control.last_step();
       }
     const double solve = (timer.wall_time() - setup) / n_solves;
-    const double memory_after = resident_mb();
+    const double memory_after = heap_mb();
 
     // the difference from the matrix-free solution, both mean-free
     VectorType amg_solution(owned, relevant, communicator);
@@ -399,7 +406,7 @@ namespace
           << " s, AMG set-up " << setup - assembly << " s, solve " << solve << " s, "
           << iterations << " iterations, matrix "
           << Utilities::MPI::sum(L.memory_consumption(), communicator) / 1e6
-          << " MB, resident growth "
+          << " MB, heap growth "
           << Utilities::MPI::sum(memory_after - memory_before, communicator) << " MB" << std::endl;
     pcout << std::scientific << std::setprecision(2)
           << "max |p_amg - p_gmg| (both mean-free): " << amg_solution.linfty_norm()
@@ -409,7 +416,7 @@ namespace
   template <int dim>
   void Benchmark<dim>::run_gmg()
   {
-    const double memory_before = resident_mb();
+    const double memory_before = heap_mb();
     Timer        timer(communicator, true);
 
     // the active level: no matrix, the load assembled matrix-free-style
@@ -535,7 +542,7 @@ namespace
         iterations = control.last_step();
       }
     const double solve = (timer.wall_time() - setup - load_time) / n_solves;
-    const double memory_after = resident_mb();
+    const double memory_after = heap_mb();
 
     constraints.distribute(x);
     VectorType ones(x);
@@ -548,11 +555,141 @@ namespace
     std::size_t operator_memory = active_data->memory_consumption() + transfer.memory_consumption();
     for (unsigned int level = 0; level < n_levels; ++level)
       operator_memory += level_operators[level].memory_consumption();
-    pcout << std::fixed << std::setprecision(3) << "gmg (Chebyshev " << smoothing_degree << "): set-up " << setup << " s, solve " << solve
+    pcout << std::fixed << std::setprecision(3) << "gmg local (Chebyshev " << smoothing_degree << "): set-up " << setup << " s, solve " << solve
           << " s, " << iterations << (converged ? "" : " (not converged)")
           << " iterations, operators and transfer "
-          << Utilities::MPI::sum(operator_memory, communicator) / 1e6 << " MB, resident growth "
+          << Utilities::MPI::sum(operator_memory, communicator) / 1e6 << " MB, heap growth "
           << Utilities::MPI::sum(memory_after - memory_before, communicator) << " MB" << std::endl;
+  }
+
+  /// geometric multigrid with global coarsening: every level is an active
+  /// mesh of its own (the fine mesh coarsened 1, 2, ... times), with its own
+  /// hanging-node and periodicity constraints, which MGTwoLevelTransfer
+  /// applies on both sides of each transfer
+  template <int dim>
+  void Benchmark<dim>::run_gmg_global()
+  {
+    const double memory_before = heap_mb();
+    Timer        timer(communicator, true);
+
+    auto active_data = std::make_shared<MatrixFree<dim, double>>();
+    typename MatrixFree<dim, double>::AdditionalData active_additional;
+    active_additional.tasks_parallel_scheme = MatrixFree<dim, double>::AdditionalData::none;
+    active_additional.mapping_update_flags  = update_gradients | update_JxW_values;
+    active_data->reinit(mapping, dof, constraints, QGauss<1>(2), active_additional);
+    ActiveOperator A;
+    A.initialize(active_data);
+
+    const auto triangulations =
+      MGTransferGlobalCoarseningTools::create_geometric_coarsening_sequence(tria);
+    const unsigned int n_levels = triangulations.size();
+    std::vector<std::unique_ptr<DoFHandler<dim>>> level_dofs(n_levels);
+    std::vector<AffineConstraints<double>>        level_constraints(n_levels);
+    MGLevelObject<LevelOperator>                  level_operators(0, n_levels - 1);
+    MGLevelObject<MGTwoLevelTransfer<dim, LevelVector>> transfers(0, n_levels - 1);
+    unsigned int coarse_periodic_faces = 0;
+    for (unsigned int level = 0; level < n_levels; ++level)
+      {
+        const DoFHandler<dim> *level_dof = &dof;
+        if (level + 1 < n_levels)
+          {
+            level_dofs[level] = std::make_unique<DoFHandler<dim>>(*triangulations[level]);
+            level_dofs[level]->distribute_dofs(fe);
+            level_dof = level_dofs[level].get();
+          }
+        AffineConstraints<double> &c = level_constraints[level];
+        c.reinit(DoFTools::extract_locally_relevant_dofs(*level_dof));
+        DoFTools::make_hanging_node_constraints(*level_dof, c);
+        if (periodic)
+          for (unsigned int d = 0; d + 1 < dim; ++d)
+            DoFTools::make_periodicity_constraints(*level_dof, 2 * d, 2 * d + 1, d, c);
+        c.close();
+        if (level == 0)
+          for (const auto &cell : triangulations[0]->active_cell_iterators())
+            if (cell->is_locally_owned())
+              for (const unsigned int f : cell->face_indices())
+                coarse_periodic_faces += cell->has_periodic_neighbor(f);
+
+        typename MatrixFree<dim, float>::AdditionalData additional;
+        additional.tasks_parallel_scheme = MatrixFree<dim, float>::AdditionalData::none;
+        additional.mapping_update_flags  = update_gradients | update_JxW_values;
+        auto level_data = std::make_shared<MatrixFree<dim, float>>();
+        level_data->reinit(mapping, *level_dof, c, QGauss<1>(2), additional);
+        level_operators[level].initialize(level_data);
+        level_operators[level].compute_diagonal();
+      }
+    std::vector<AffineConstraints<float>> transfer_constraints(n_levels);
+    for (unsigned int level = 0; level < n_levels; ++level)
+      transfer_constraints[level].copy_from(level_constraints[level]);
+    for (unsigned int level = 1; level < n_levels; ++level)
+      transfers[level].reinit_geometric_transfer(
+        level + 1 < n_levels ? *level_dofs[level] : dof, *level_dofs[level - 1],
+        transfer_constraints[level], transfer_constraints[level - 1]);
+    MGTransferGlobalCoarsening<dim, LevelVector> transfer(
+      transfers, [&](const unsigned int level, LevelVector &v) {
+        level_operators[level].initialize_dof_vector(v);
+      });
+
+    using Smoother = PreconditionChebyshev<LevelOperator, LevelVector>;
+    mg::SmootherRelaxation<Smoother, LevelVector>     smoother;
+    MGLevelObject<typename Smoother::AdditionalData> smoother_data(0, n_levels - 1);
+    for (unsigned int level = 0; level < n_levels; ++level)
+      {
+        smoother_data[level].smoothing_range     = 15.;
+        smoother_data[level].degree              = smoothing_degree;
+        smoother_data[level].eig_cg_n_iterations = 10;
+        smoother_data[level].preconditioner =
+          level_operators[level].get_matrix_diagonal_inverse();
+      }
+    smoother.initialize(level_operators, smoother_data);
+    MeanFreeCoarseSolver<LevelOperator, LevelVector> coarse(level_operators[0]);
+    mg::Matrix<LevelVector> level_matrix(level_operators);
+    Multigrid<LevelVector>  mg(level_matrix, coarse, transfer, smoother, smoother);
+    PreconditionMG<dim, LevelVector, MGTransferGlobalCoarsening<dim, LevelVector>>
+      preconditioner(dof, mg, transfer);
+    const double setup = timer.wall_time();
+
+    VectorType x;
+    active_data->initialize_dof_vector(x);
+    unsigned int iterations = 0;
+    bool         converged  = true;
+    for (unsigned int s = 0; s < n_solves; ++s)
+      {
+        x = 0.;
+        SolverControl        control(300, tolerance * gmg_rhs.l2_norm());
+        SolverCG<VectorType> cg(control);
+        try
+          {
+            cg.solve(A, x, gmg_rhs, preconditioner);
+          }
+        catch (const SolverControl::NoConvergence &)
+          {
+            converged = false;
+          }
+        iterations = control.last_step();
+      }
+    const double solve        = (timer.wall_time() - setup) / n_solves;
+    const double memory_after = heap_mb();
+
+    constraints.distribute(x);
+    VectorType ones(x);
+    ones = 1.;
+    x.add(-(x * ones) / static_cast<double>(dof.n_dofs()), ones);
+    x -= gmg_solution;
+
+    std::size_t operator_memory = active_data->memory_consumption();
+    for (unsigned int level = 0; level < n_levels; ++level)
+      operator_memory += level_operators[level].memory_consumption();
+    pcout << std::fixed << std::setprecision(3) << "gmg global (Chebyshev " << smoothing_degree
+          << "): set-up " << setup << " s, solve " << solve << " s, " << iterations
+          << (converged ? "" : " (not converged)") << " iterations, operators "
+          << Utilities::MPI::sum(operator_memory, communicator) / 1e6 << " MB, heap growth "
+          << Utilities::MPI::sum(memory_after - memory_before, communicator) << " MB, "
+          << n_levels << " levels, "
+          << Utilities::MPI::sum(coarse_periodic_faces, communicator)
+          << " periodic faces on the coarsest" << std::endl;
+    pcout << std::scientific << std::setprecision(2)
+          << "max |p_global - p_local| (both mean-free): " << x.linfty_norm() << std::endl;
   }
 
   template <int dim>
@@ -560,6 +697,7 @@ namespace
   {
     make_mesh();
     run_gmg();
+    run_gmg_global();
     run_amg();
   }
 } // namespace

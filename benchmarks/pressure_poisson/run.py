@@ -34,7 +34,7 @@ ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIR
 # main job's level 7 (its 6 x 2 mesh refined twice globally is level 2)
 CASES = [(2, 5), (2, 6), (2, 7), (3, 3), (3, 4)]
 FIELDS = ["dim", "level", "faces", "pressure DoFs", "method", "set-up s", "solve s",
-          "iterations", "converged", "resident MB", "max difference"]
+          "iterations", "converged", "heap MB", "max difference"]
 
 
 def build():
@@ -52,25 +52,30 @@ def number(pattern, text):
 
 def run(exe, dim, level, faces):
     env = dict(ENV)
+    env.pop("PRESSURE_POISSON_WALLS", None)
     if faces == "walls":
         env["PRESSURE_POISSON_WALLS"] = "1"
     out = subprocess.run([exe, str(dim), str(level), "2"], env=env, capture_output=True,
                          text=True, check=True).stdout
     dofs = int(number(r"(\d+) pressure DoFs", out))
     difference = number(r"max \|p_amg - p_gmg\| \(both mean-free\): (\S+)", out)
-    gmg = {"set-up s": number(r"gmg.*set-up (\S+) s", out),
-           "solve s": number(r"gmg.*solve (\S+) s", out),
-           "iterations": int(number(r"gmg.*?(\d+)(?: \(not converged\))? iterations", out)),
-           "converged": "not converged" not in out,
-           "resident MB": number(r"gmg.*resident growth (\S+) MB", out)}
+    def multigrid(name):
+        return {"set-up s": number(name + r".*set-up (\S+) s", out),
+                "solve s": number(name + r".*solve (\S+) s", out),
+                "iterations": int(number(name + r".*?(\d+)(?: \(not converged\))? iterations",
+                                         out)),
+                "converged": not re.search(name + r".*not converged", out),
+                "heap MB": number(name + r".*heap growth (\S+) MB", out)}
+    local, global_ = multigrid("gmg local"), multigrid("gmg global")
     amg = {"set-up s": number(r"amg: assembly (\S+) s", out)
            + number(r"AMG set-up (\S+) s", out),
            "solve s": number(r"amg:.*solve (\S+) s", out),
            "iterations": int(number(r"amg:.*?(\d+) iterations", out)),
            "converged": True,
-           "resident MB": number(r"amg:.*resident growth (\S+) MB", out)}
+           "heap MB": number(r"amg:.*heap growth (\S+) MB", out)}
     rows = []
-    for method, r in (("BoomerAMG, assembled", amg), ("GMG, matrix-free", gmg)):
+    for method, r in (("BoomerAMG, assembled", amg), ("GMG local smoothing, matrix-free", local),
+                      ("GMG global coarsening, matrix-free", global_)):
         rows.append(dict(r, **{"dim": dim, "level": level, "faces": faces,
                                "pressure DoFs": dofs, "method": method,
                                "max difference": difference}))
@@ -79,22 +84,25 @@ def run(exe, dim, level, faces):
 
 def table(rows):
     print("| dim | faces | pressure DoFs | method | set-up s | solve s | iterations |"
-          " resident MB | solve GMG/AMG |")
+          " heap MB | solve / AMG's |")
     print("|---|---|---|---|---|---|---|---|---|")
-    for i in range(0, len(rows), 2):
-        amg, gmg = rows[i], rows[i + 1]
-        for r in (amg, gmg):
-            ratio = (f"{float(gmg['solve s']) / float(amg['solve s']):.2f}"
-                     if r is gmg else "")
+    for i in range(0, len(rows), 3):
+        amg = rows[i]
+        for r in rows[i:i + 3]:
+            ratio = (f"{float(r['solve s']) / float(amg['solve s']):.2f}"
+                     if r is not amg else "")
             print(f"| {r['dim']} | {r['faces']} | {r['pressure DoFs']} | {r['method']} |"
                   f" {float(r['set-up s']):.3f} | {float(r['solve s']):.3f} |"
-                  f" {r['iterations']}{'' if str(r['converged']) == 'True' else ' (cap)'} | {float(r['resident MB']):.1f} | {ratio} |")
+                  f" {r['iterations']}{'' if str(r['converged']) == 'True' else ' (cap)'} |"
+                  f" {float(r['heap MB']):.1f} | {ratio} |")
 
 
 def chart(rows):
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
     for ax, dim in zip(axes, (2, 3)):
-        for method, marker in (("BoomerAMG, assembled", "o"), ("GMG, matrix-free", "s")):
+        for method, marker in (("BoomerAMG, assembled", "o"),
+                               ("GMG local smoothing, matrix-free", "s"),
+                               ("GMG global coarsening, matrix-free", "^")):
             for faces, style in (("periodic", "-"), ("walls", "--")):
                 sel = [r for r in rows if int(r["dim"]) == dim and r["method"] == method
                        and r["faces"] == faces]
