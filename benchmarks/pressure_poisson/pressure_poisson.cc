@@ -238,6 +238,21 @@ namespace
     void run_gmg();
     void run_gmg_global();
 
+    using Smoother = PreconditionChebyshev<LevelOperator, LevelVector>;
+    /// the matrix-free Laplacian of the active mesh (both multigrid paths)
+    std::shared_ptr<MatrixFree<dim, double>> make_active_operator(ActiveOperator &A) const;
+    /// Chebyshev of degree smoothing_degree around each level's Jacobi
+    MGLevelObject<typename Smoother::AdditionalData>
+    chebyshev_data(const MGLevelObject<LevelOperator> &level_operators) const;
+    /// n_solves CG solves of A x = b from zero, at most 300 iterations each
+    /// (with periodic faces the local-smoothing multigrid is not a
+    /// converging preconditioner, doc/method.md: reported, not aborted);
+    /// returns the last solve's iterations and whether all converged
+    template <typename Preconditioner>
+    std::pair<unsigned int, bool> solve_repeatedly(const ActiveOperator &A, VectorType &x,
+                                                   const VectorType     &b,
+                                                   const Preconditioner &preconditioner) const;
+
     MPI_Comm                                  communicator;
     ConditionalOStream                        pcout;
     Box<dim>                                  box;
@@ -270,6 +285,61 @@ namespace
     , max_level(max_level)
     , n_solves(n_solves)
   {}
+
+  template <int dim>
+  std::shared_ptr<MatrixFree<dim, double>>
+  Benchmark<dim>::make_active_operator(ActiveOperator &A) const
+  {
+    auto data = std::make_shared<MatrixFree<dim, double>>();
+    typename MatrixFree<dim, double>::AdditionalData additional;
+    additional.tasks_parallel_scheme = MatrixFree<dim, double>::AdditionalData::none;
+    additional.mapping_update_flags  = update_gradients | update_JxW_values;
+    data->reinit(mapping, dof, constraints, QGauss<1>(2), additional);
+    A.initialize(data);
+    return data;
+  }
+
+  template <int dim>
+  auto Benchmark<dim>::chebyshev_data(const MGLevelObject<LevelOperator> &level_operators) const
+    -> MGLevelObject<typename Smoother::AdditionalData>
+  {
+    MGLevelObject<typename Smoother::AdditionalData> data(level_operators.min_level(),
+                                                          level_operators.max_level());
+    for (unsigned int level = data.min_level(); level <= data.max_level(); ++level)
+      {
+        data[level].smoothing_range     = 15.;
+        data[level].degree              = smoothing_degree;
+        data[level].eig_cg_n_iterations = 10;
+        data[level].preconditioner      = level_operators[level].get_matrix_diagonal_inverse();
+      }
+    return data;
+  }
+
+  template <int dim>
+  template <typename Preconditioner>
+  std::pair<unsigned int, bool>
+  Benchmark<dim>::solve_repeatedly(const ActiveOperator &A, VectorType &x, const VectorType &b,
+                                   const Preconditioner &preconditioner) const
+  {
+    unsigned int iterations = 0;
+    bool         converged  = true;
+    for (unsigned int s = 0; s < n_solves; ++s)
+      {
+        x = 0.;
+        SolverControl        control(300, tolerance * b.l2_norm());
+        SolverCG<VectorType> cg(control);
+        try
+          {
+            cg.solve(A, x, b, preconditioner);
+          }
+        catch (const SolverControl::NoConvergence &)
+          {
+            converged = false;
+          }
+        iterations = control.last_step();
+      }
+    return {iterations, converged};
+  }
 
   template <int dim>
   void Benchmark<dim>::make_mesh()
@@ -404,9 +474,7 @@ namespace
 
     pcout << std::fixed << std::setprecision(3) << "amg: assembly " << assembly
           << " s, AMG set-up " << setup - assembly << " s, solve " << solve << " s, "
-          << iterations << " iterations, matrix "
-          << Utilities::MPI::sum(L.memory_consumption(), communicator) / 1e6
-          << " MB, heap growth "
+          << iterations << " iterations, heap growth "
           << Utilities::MPI::sum(memory_after - memory_before, communicator) << " MB" << std::endl;
     pcout << std::scientific << std::setprecision(2)
           << "max |p_amg - p_gmg| (both mean-free): " << amg_solution.linfty_norm()
@@ -421,13 +489,8 @@ namespace
 
     // the active level: no matrix, the load assembled matrix-free-style
     // with FEValues (the solver's projection gets it from D u)
-    auto active_data = std::make_shared<MatrixFree<dim, double>>();
-    typename MatrixFree<dim, double>::AdditionalData active_additional;
-    active_additional.tasks_parallel_scheme = MatrixFree<dim, double>::AdditionalData::none;
-    active_additional.mapping_update_flags  = update_gradients | update_JxW_values;
-    active_data->reinit(mapping, dof, constraints, QGauss<1>(2), active_additional);
     ActiveOperator A;
-    A.initialize(active_data);
+    const auto     active_data = make_active_operator(A);
 
     MGConstrainedDoFs mg_constrained_dofs;
     mg_constrained_dofs.initialize(dof);
@@ -450,18 +513,8 @@ namespace
     MGTransferMatrixFree<dim, float> transfer(mg_constrained_dofs);
     transfer.build(dof);
 
-    using Smoother = PreconditionChebyshev<LevelOperator, LevelVector>;
-    mg::SmootherRelaxation<Smoother, LevelVector>     smoother;
-    MGLevelObject<typename Smoother::AdditionalData> smoother_data(0, n_levels - 1);
-    for (unsigned int level = 0; level < n_levels; ++level)
-      {
-        smoother_data[level].smoothing_range     = 15.;
-        smoother_data[level].degree              = smoothing_degree;
-        smoother_data[level].eig_cg_n_iterations = 10;
-        smoother_data[level].preconditioner =
-          level_operators[level].get_matrix_diagonal_inverse();
-      }
-    smoother.initialize(level_operators, smoother_data);
+    mg::SmootherRelaxation<Smoother, LevelVector> smoother;
+    smoother.initialize(level_operators, chebyshev_data(level_operators));
     // level 0 (the coarse mesh) solved by CG to 1e-4 after the restricted
     // residual is made orthogonal to the level's constants (with walls it
     // is already; with periodic faces it is not, see doc/method.md)
@@ -522,25 +575,7 @@ namespace
     }
     const double load_time = timer.wall_time() - setup;
 
-    // at most 300 iterations: with periodic faces the multigrid is not a
-    // converging preconditioner (doc/method.md); report that, not abort
-    unsigned int iterations = 0;
-    bool         converged  = true;
-    for (unsigned int s = 0; s < n_solves; ++s)
-      {
-        x = 0.;
-        SolverControl        control(300, tolerance * b.l2_norm());
-        SolverCG<VectorType> cg(control);
-        try
-          {
-            cg.solve(A, x, b, preconditioner);
-          }
-        catch (const SolverControl::NoConvergence &)
-          {
-            converged = false;
-          }
-        iterations = control.last_step();
-      }
+    const auto [iterations, converged] = solve_repeatedly(A, x, b, preconditioner);
     const double solve = (timer.wall_time() - setup - load_time) / n_solves;
     const double memory_after = heap_mb();
 
@@ -572,13 +607,8 @@ namespace
     const double memory_before = heap_mb();
     Timer        timer(communicator, true);
 
-    auto active_data = std::make_shared<MatrixFree<dim, double>>();
-    typename MatrixFree<dim, double>::AdditionalData active_additional;
-    active_additional.tasks_parallel_scheme = MatrixFree<dim, double>::AdditionalData::none;
-    active_additional.mapping_update_flags  = update_gradients | update_JxW_values;
-    active_data->reinit(mapping, dof, constraints, QGauss<1>(2), active_additional);
     ActiveOperator A;
-    A.initialize(active_data);
+    const auto     active_data = make_active_operator(A);
 
     const auto triangulations =
       MGTransferGlobalCoarseningTools::create_geometric_coarsening_sequence(tria);
@@ -630,18 +660,8 @@ namespace
         level_operators[level].initialize_dof_vector(v);
       });
 
-    using Smoother = PreconditionChebyshev<LevelOperator, LevelVector>;
-    mg::SmootherRelaxation<Smoother, LevelVector>     smoother;
-    MGLevelObject<typename Smoother::AdditionalData> smoother_data(0, n_levels - 1);
-    for (unsigned int level = 0; level < n_levels; ++level)
-      {
-        smoother_data[level].smoothing_range     = 15.;
-        smoother_data[level].degree              = smoothing_degree;
-        smoother_data[level].eig_cg_n_iterations = 10;
-        smoother_data[level].preconditioner =
-          level_operators[level].get_matrix_diagonal_inverse();
-      }
-    smoother.initialize(level_operators, smoother_data);
+    mg::SmootherRelaxation<Smoother, LevelVector> smoother;
+    smoother.initialize(level_operators, chebyshev_data(level_operators));
     MeanFreeCoarseSolver<LevelOperator, LevelVector> coarse(level_operators[0]);
     mg::Matrix<LevelVector> level_matrix(level_operators);
     Multigrid<LevelVector>  mg(level_matrix, coarse, transfer, smoother, smoother);
@@ -651,23 +671,7 @@ namespace
 
     VectorType x;
     active_data->initialize_dof_vector(x);
-    unsigned int iterations = 0;
-    bool         converged  = true;
-    for (unsigned int s = 0; s < n_solves; ++s)
-      {
-        x = 0.;
-        SolverControl        control(300, tolerance * gmg_rhs.l2_norm());
-        SolverCG<VectorType> cg(control);
-        try
-          {
-            cg.solve(A, x, gmg_rhs, preconditioner);
-          }
-        catch (const SolverControl::NoConvergence &)
-          {
-            converged = false;
-          }
-        iterations = control.last_step();
-      }
+    const auto [iterations, converged] = solve_repeatedly(A, x, gmg_rhs, preconditioner);
     const double solve        = (timer.wall_time() - setup) / n_solves;
     const double memory_after = heap_mb();
 
