@@ -220,19 +220,37 @@ namespace Suspension::Solid
                 highest = std::max(highest, local[i]);
               }
           const double margin = fe.degree > 1 ? 0.1 : 0.;
-          const bool   cut    = lowest < 0.5 + margin && highest >= 0.5 - margin;
+          // with 'Shape measure = profile' the interface inside a cut cell
+          // is the profile the transport carries
+          const bool profiled = shape_on_profile && transport.has_profile(cell->active_cell_index());
+          const bool cut = profiled || (lowest < 0.5 + margin && highest >= 0.5 - margin);
           if (cut)
             {
               fe_fine.reinit(cell);
               fe_u_fine.reinit(velocity_cell);
               fe_fine[phi_x].get_function_values(solution, phi_fine);
+              if (profiled)
+                for (const unsigned int q : fe_fine.quadrature_point_indices())
+                  phi_fine[q] = transport.profile_value(cell->active_cell_index(),
+                                                        fe_fine.quadrature_point(q), phi_fine[q]);
               fe_u_fine[velocities].get_function_values(velocity, u_fine);
               for (const unsigned int q : fe_fine.quadrature_point_indices())
-                if (phi_fine[q] >= 0.5)
-                  {
-                    m[3 * n_m + 1] += fe_fine.JxW(q);
-                    add(&m[2 * n_m], fe_fine.JxW(q), fe_fine.quadrature_point(q), u_fine[q]);
-                  }
+                {
+                  if (phi_fine[q] >= 0.5)
+                    {
+                      m[3 * n_m + 1] += fe_fine.JxW(q);
+                      add(&m[2 * n_m], fe_fine.JxW(q), fe_fine.quadrature_point(q), u_fine[q]);
+                    }
+                  // the profile is a step within a fraction of the cell,
+                  // which a few Gauss points would snap to: the stress
+                  // weight's moments and the area on the sub-cells
+                  if (profiled)
+                    {
+                      m[3 * n_m] += (phi_fine[q] >= 0.5 ? fe_fine.JxW(q) : 0.);
+                      add(&m[0], weight(phi_fine[q]) * fe_fine.JxW(q), fe_fine.quadrature_point(q),
+                          u_fine[q]);
+                    }
+                }
             }
           // B only where the cell reaches the core (most cells hold fluid)
           const bool core_cell =
@@ -242,7 +260,8 @@ namespace Suspension::Solid
           for (const unsigned int q : fe_values.quadrature_point_indices())
             {
               const auto &x = fe_values.quadrature_point(q);
-              m[3 * n_m] += (phi[q] >= 0.5 ? fe_values.JxW(q) : 0.);
+              if (!profiled)
+                m[3 * n_m] += (phi[q] >= 0.5 ? fe_values.JxW(q) : 0.);
               if (!cut && lowest >= 0.5)
                 {
                   m[3 * n_m + 1] += fe_values.JxW(q);
@@ -255,7 +274,8 @@ namespace Suspension::Solid
                     core[1 + k] += fe_values.JxW(q) *
                                    B[q].access_raw_entry(k);
                 }
-              add(&m[0], weight(phi[q]) * fe_values.JxW(q), x, u[q]);
+              if (!profiled)
+                add(&m[0], weight(phi[q]) * fe_values.JxW(q), x, u[q]);
               add(&m[n_m], phi[q] * fe_values.JxW(q), x, u[q]);
             }
         }

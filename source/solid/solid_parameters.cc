@@ -113,6 +113,18 @@ namespace Suspension::Parameters
                       Patterns::Double(0., 1.),
                       "Range of phi around 1/2 across which the sharp stress "
                       "weight rises from 0 to 1.");
+    prm.declare_entry("Shape measure", d.shape_on_profile ? "profile" : "polynomial",
+                      Patterns::Selection("profile|polynomial"),
+                      "With 'Interface reconstruction = THINC': which phi a "
+                      "particle's measures (centroid, D, inclination, "
+                      "area(phi >= 1/2) and their sub-cell versions in "
+                      "statistics.txt) read in the cells the interface cuts. "
+                      "profile: the THINC profile the transport carries, on "
+                      "24 x 24 (8 x 8 x 8) sub-cells; polynomial: its "
+                      "projection onto the cell's DG polynomial, at the Gauss "
+                      "points (sessions 9 to 17). The stress weight H(phi) "
+                      "reads the polynomial either way (doc/method.md, 'The "
+                      "shape of the interface the transport carries').");
     prm.declare_entry("B reset fraction", "-1", Patterns::Double(-1., 1.),
                       "Sharp stress weight: B is reset to I at the nodes where "
                       "phi is at most this; negative: where H(phi) = 0 (phi <= "
@@ -243,6 +255,7 @@ namespace Suspension::Parameters
     semi_implicit       = prm.get("Elastic coupling") == "semi-implicit";
     sharp_stress        = prm.get("Stress weight") == "sharp";
     stress_weight_width = prm.get_double("Stress weight width");
+    shape_on_profile    = prm.get("Shape measure") == "profile";
     interface_compression = prm.get_double("Interface compression");
     interface_thickness   = prm.get_double("Interface thickness");
     thinc_reconstruction  = prm.get("Interface reconstruction") == "THINC";

@@ -87,6 +87,7 @@ namespace Suspension::Solid
                               const parallel::distributed::Triangulation<dim> &tria)
     : parameters(parameters)
     , weight(parameters.solid)
+    , shape_on_profile(parameters.solid.shape_on_profile && parameters.solid.thinc_reconstruction)
     , fe(make_fe<dim>(parameters.solid))
     , dof_handler(tria)
   {
@@ -150,6 +151,9 @@ namespace Suspension::Solid
       initial_report = project_initial_fraction(parameters, dof_handler, solution);
     if (parameters.solid.limiter)
       transport.limit(solution, true);
+    // what particle_shape() reads: the profiles of the current phi, kept so
+    // by advance(), finish_mesh_change() and resume_from_checkpoint()
+    transport.update_profiles(solution);
     boundary_outflow = 0.;
     updates          = 0;
     initial_volume   = diagnostics().volume;
@@ -186,6 +190,7 @@ namespace Suspension::Solid
     // as saved: already limited, so no limiter here (it would not be the
     // uninterrupted run's state)
     solution.zero_out_ghost_values();
+    transport.update_profiles(solution);
   }
 
   template <int dim>
@@ -217,6 +222,7 @@ namespace Suspension::Solid
     transport.limit(solution, true);
     if (fe.n_components() > 1)
       transport.limit_B(solution);
+    transport.update_profiles(solution);
   }
 
   template <int dim>
@@ -438,6 +444,7 @@ namespace Suspension::Solid
     // degree > 1 the limiter does (cell means unchanged)
     if (parameters.solid.limiter && parameters.solid.degree > 1)
       transport.limit(solution, true);
+    transport.update_profiles(solution);
   }
 
   template <int dim>

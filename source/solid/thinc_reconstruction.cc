@@ -298,6 +298,33 @@ namespace Suspension::Solid
   }
 
   template <int dim>
+  void TransportOperator<dim>::update_profiles(const VectorType &solution) const
+  {
+    if (thinc_beta > 0.)
+      compute_reconstruction(solution);
+  }
+
+  template <int dim>
+  bool TransportOperator<dim>::has_profile(const unsigned int active_cell_index) const
+  {
+    if (!(thinc_beta > 0.))
+      return false;
+    const unsigned int k = owned_cell_lane[active_cell_index];
+    Assert(k != numbers::invalid_unsigned_int, ExcMessage("not a locally owned cell"));
+    return reconstruction[k / VA::size()][k % VA::size()].weight > 0.;
+  }
+
+  template <int dim>
+  double TransportOperator<dim>::profile_value(const unsigned int active_cell_index,
+                                               const Point<dim> &x, const double dg_value) const
+  {
+    if (!has_profile(active_cell_index))
+      return dg_value;
+    const unsigned int k = owned_cell_lane[active_cell_index];
+    return profile_phi(reconstruction[k / VA::size()][k % VA::size()], x, dg_value);
+  }
+
+  template <int dim>
   bool TransportOperator<dim>::project_to_profiles(VectorType &solution) const
   {
     if (!(thinc_beta > 0.))

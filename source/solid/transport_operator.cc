@@ -63,6 +63,11 @@ namespace Suspension::Solid
       for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
         lane_cell_index[cell * VectorizedArray<double>::size() + v] =
           matrix_free.get_cell_iterator(cell, v)->active_cell_index();
+    owned_cell_lane.assign(dof_solid.get_triangulation().n_active_cells(), numbers::invalid_unsigned_int);
+    for (unsigned int cell = 0; cell < matrix_free.n_cell_batches(); ++cell)
+      for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+        owned_cell_lane[lane_cell_index[cell * VectorizedArray<double>::size() + v]] =
+          cell * VectorizedArray<double>::size() + v;
 
     // the periodic faces among the inner faces (a cell's face on the
     // domain's boundary that has a neighbour across it)

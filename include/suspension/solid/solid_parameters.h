@@ -42,6 +42,9 @@ namespace Suspension::Parameters
     /// stress G H(phi) (B - I): H a smooth step across 1/2 (sharp) or phi
     bool                             sharp_stress        = true;
     double                           stress_weight_width = 0.2;
+    /// with THINC: the particle measures read phi from the cut cells'
+    /// profiles (else from the DG polynomial, their projection)
+    bool                             shape_on_profile    = true;
     double                           interface_compression = 0.; // c of the compressive flux
     double                           interface_thickness   = 0.25; // eps / h of its diffusion
     /// THINC profile of phi in interface cells for the transport fluxes

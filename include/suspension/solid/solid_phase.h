@@ -239,6 +239,8 @@ namespace Suspension::Solid
 
     const Parameters::All &parameters;
     const StressWeight     weight;
+    /// 'Shape measure = profile' and THINC on
+    const bool             shape_on_profile;
     InitialFractionReport  initial_report;
     FESystem<dim>          fe;
     DoFHandler<dim>        dof_handler;

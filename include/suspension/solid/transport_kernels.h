@@ -49,6 +49,34 @@ namespace Suspension::Solid::internal
     return std::clamp(x, lower, upper);
   }
 
+  // The THINC profile r at x (a point of the cell, or of one of its faces
+  // given across a periodic boundary): p + w (H - p), p the DG value, w
+  // how much of the profile the transport sees.
+  template <int dim, typename Reconstruction>
+  double profile_phi(const Reconstruction &r, const Point<dim> &x, const double dg_value)
+  {
+    double argument = r.offset;
+    // for the curved profile: s = (x - centre) / h, n from the slope
+    double s2 = 0., sn = 0., nn = 0.;
+    for (unsigned int d = 0; d < dim; ++d)
+      {
+        const double y = on_cell_face(x[d], r.lower[d], r.upper[d]);
+        argument += r.slope[d] * y;
+        if (r.curvature == 0.)
+          continue;
+        const double h = r.upper[d] - r.lower[d];
+        const double s = (y - 0.5 * (r.lower[d] + r.upper[d])) / h;
+        s2 += s * s;
+        sn += r.slope[d] * h * s;
+        nn += r.slope[d] * h * r.slope[d] * h;
+      }
+    if (r.curvature != 0.)
+      argument += r.curvature * (s2 - sn * sn / nn);
+    // 1/2 (1 + tanh a) = 1 / (1 + exp(-2a)): one exp, cheaper than
+    // glibc's tanh (which goes through expm1)
+    return dg_value + r.weight * (1. / (1. + std::exp(-2. * argument)) - dg_value);
+  }
+
   // phi where the transport sees it: the cell's THINC profile at x in
   // the lanes that have one, the DG value elsewhere
   template <int dim, typename Lanes>
@@ -58,27 +86,10 @@ namespace Suspension::Solid::internal
     for (unsigned int v = 0; v < VA::size(); ++v)
       if (profile[v].weight > 0.)
         {
-          const auto &r        = profile[v];
-          double      argument = r.offset;
-          // for the curved profile: s = (x - centre) / h, n from the slope
-          double s2 = 0., sn = 0., nn = 0.;
+          Point<dim> x_v;
           for (unsigned int d = 0; d < dim; ++d)
-            {
-              const double y = on_cell_face(x[d][v], r.lower[d], r.upper[d]);
-              argument += r.slope[d] * y;
-              if (r.curvature == 0.)
-                continue;
-              const double h = r.upper[d] - r.lower[d];
-              const double s = (y - 0.5 * (r.lower[d] + r.upper[d])) / h;
-              s2 += s * s;
-              sn += r.slope[d] * h * s;
-              nn += r.slope[d] * h * r.slope[d] * h;
-            }
-          if (r.curvature != 0.)
-            argument += r.curvature * (s2 - sn * sn / nn);
-          // 1/2 (1 + tanh a) = 1 / (1 + exp(-2a)): one exp, cheaper than
-          // glibc's tanh (which goes through expm1)
-          out[v] += r.weight * (1. / (1. + std::exp(-2. * argument)) - dg_value[v]);
+            x_v[d] = x[d][v];
+          out[v] = profile_phi(profile[v], x_v, dg_value[v]);
         }
     return out;
   }

@@ -151,6 +151,21 @@ namespace Suspension::Solid
     /// Returns whether it did (only with the reconstruction on).
     bool project_to_profiles(VectorType &solution) const;
 
+    /// The THINC profiles of the current solution, for profile_value():
+    /// what project_to_profiles() computes, without changing the solution.
+    /// Nothing without the reconstruction.
+    void update_profiles(const VectorType &solution) const;
+
+    /// phi as the transport carries it at the point x of the locally owned
+    /// cell with this active_cell_index(): the cell's THINC profile (p + w
+    /// (H - p)) if it has one, else `dg_value`, the DG polynomial at x.
+    /// The profiles are those of the last update_profiles() or
+    /// project_to_profiles().
+    double profile_value(unsigned int active_cell_index, const Point<dim> &x, double dg_value) const;
+
+    /// whether that cell has a profile (it is cut by the interface)
+    bool has_profile(unsigned int active_cell_index) const;
+
     /// The profile of one cell as a function of x: 1/2 (1 + tanh(slope.x +
     /// offset)), or none (the DG polynomial is used).
     struct Reconstruction
@@ -217,6 +232,9 @@ namespace Suspension::Solid
     AlignedVector<VectorizedArray<double>> b_active;
     /// active_cell_index() of each lane of the owned and ghost cell batches
     std::vector<unsigned int> lane_cell_index;
+    /// batch * lanes + lane of each locally owned active cell (by
+    /// active_cell_index(); invalid for the others)
+    std::vector<unsigned int> owned_cell_lane;
     /// 1 in the lanes of inner face batches that are periodic faces
     std::vector<unsigned char> periodic_face_lane;
     /// solution with the ghost values of the face neighbours (face_jumps)
