@@ -267,6 +267,15 @@ namespace Suspension::Parameters
                       "deformation measure') at the end of each run must "
                       "differ from its value at the first 'Report times' entry "
                       "by at most this relative amount.");
+    prm.declare_entry("Area tolerance",
+                      "0",
+                      Patterns::Double(0.),
+                      "If positive, with a single particle: the largest "
+                      "|area(phi >= 1/2) / int phi(0) - 1| over every step "
+                      "of the run (area(phi >= 1/2) as statistics.txt's "
+                      "solid_area: on the THINC profile with 'Solid/Shape "
+                      "measure = profile') is printed at the end and "
+                      "checked against this (verdict printed).");
     prm.declare_entry("Sweep minimum cell reduction",
                       "0",
                       Patterns::Double(0),
@@ -311,6 +320,7 @@ namespace Suspension::Parameters
     sweep_expected_deformation = Utilities::trim(prm.get("Sweep expected deformation"));
     sweep_agreement            = prm.get_double("Sweep agreement");
     sweep_cell_reduction       = prm.get_double("Sweep minimum cell reduction");
+    area_tolerance             = prm.get_double("Area tolerance");
     sweep_material_deformation = prm.get("Sweep deformation measure") == "material";
     steady_tolerance           = prm.get_double("Steady tolerance");
     time_step_cycles  = prm.get_integer("Time step cycles");

@@ -3,6 +3,8 @@
 #include <suspension/core/scene.h>
 #include <suspension/postprocess/solid_report.h>
 
+#include <algorithm>
+#include <cmath>
 #include <iomanip>
 #include <sstream>
 
@@ -72,6 +74,9 @@ namespace Suspension::Postprocess
         statistics.add_value("D", shape.taylor_deformation);
         statistics.add_value("theta_deg", shape.inclination);
         statistics.add_value("solid_area", shape.solid_area);
+        if (solid.initial_phi_volume() > 0.)
+          largest_area_error = std::max(largest_area_error,
+                                        std::abs(shape.solid_area / solid.initial_phi_volume() - 1.));
         statistics.add_value("D_phi", shape.taylor_deformation_phi);
         statistics.add_value("solid_area_subcell", shape.solid_area_subcell);
         statistics.add_value("D_half", shape.taylor_deformation_half);
@@ -183,6 +188,11 @@ namespace Suspension::Postprocess
       {
         out << "  final: " << describe(solid.particle_shape(space, velocity))
               << std::endl;
+        if (const double tolerance = parameters.verification.area_tolerance; tolerance > 0.)
+          out << "  area(phi >= 1/2) against int phi(0), largest deviation over the steps: "
+              << std::fixed << std::setprecision(3) << 100. * largest_area_error << " % <= "
+              << 100. * tolerance << " %: " << (largest_area_error <= tolerance ? "yes" : "no")
+              << std::defaultfloat << std::endl;
       }
     report_probes(out, time);
     if (!parameters.verification.exact_fraction.empty())

@@ -88,6 +88,9 @@ namespace Suspension::Parameters
     bool                sweep_material_deformation = false;
     /// |D(end) / D(first report time) - 1| of the single particle at most this (0: off)
     double              steady_tolerance = 0.;
+    /// |area(phi >= 1/2) / int phi(0) - 1| of the single particle at most
+    /// this at every step (0: off)
+    double              area_tolerance = 0.;
 
     static void declare(ParameterHandler &prm, unsigned int dim);
     void        parse(ParameterHandler &prm, unsigned int dim);

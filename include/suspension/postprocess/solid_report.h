@@ -65,5 +65,8 @@ namespace Suspension::Postprocess
     const Fluid::FluidSpace<dim> &space;
     double                        l1_error = -1., cell_l1_error = -1.;
     std::vector<std::array<double, 3>> shapes;
+    /// largest |area(phi >= 1/2) / int phi(0) - 1| of the single particle
+    /// over the steps reported in statistics.txt (since this run started)
+    mutable double                largest_area_error = 0.;
   };
 } // namespace Suspension::Postprocess
