@@ -122,7 +122,8 @@ namespace Suspension::Solid
     transport.set_reconstruction(parameters.solid.thinc_reconstruction ?
                                    parameters.solid.thinc_sharpness :
                                    0.,
-                                 parameters.solid.thinc_curvature);
+                                 parameters.solid.thinc_curvature,
+                                 parameters.solid.thinc_smoothed_normal);
     transport.reinit(dof_handler, fluid_space.dof_velocity, velocity_constraints,
                      parameters.solid.elastic());
     transport.set_compression(parameters.solid.interface_compression,

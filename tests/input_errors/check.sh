@@ -81,6 +81,7 @@ expect directory_as_file  "$dir"                       -- "input_errors" "is a d
 expect study_not_channel  "$dir/valid.prm" --list-cases -- "valid.prm" "Geometry/Type" "channel"
 expect study_no_reynolds  "$dir/../../parameters/study_2d_paper.prm" --list-cases --set Study/Cases=grid -- "study_2d_paper.prm" "Study/Reynolds numbers" "no Reynolds number"
 expect study_bad_cases    "$dir/../../parameters/study_2d_paper.prm" --list-cases --set Study/Cases=papers -- "Study/Cases" "papers"
+expect smoothed_normal    "$dir/smoothed_normal_plane.prm" -- "smoothed_normal_plane.prm" "Solid/THINC normal" "THINC curvature"
 
 echo "$failures failure(s)"
 [ "$failures" -eq 0 ]

@@ -51,6 +51,9 @@ namespace Suspension::Parameters
     bool                             thinc_reconstruction = true;
     double                           thinc_sharpness      = 3.5; // beta, per cell
     bool                             thinc_curvature      = true; // curved profile
+    /// the profile's normal: the mean of the cell's vertex normals where
+    /// they agree (else Youngs'), or Youngs' everywhere
+    bool                             thinc_smoothed_normal = false;
     double                           B_reset_fraction = -1.; // < 0: where H = 0
     double                           interface_relaxation = 0.; // R of B - I at rate R (1 - H)
     /// algebraic sharpening of phi after every `sharpening_interval` steps

@@ -137,11 +137,15 @@ namespace Suspension::Solid
     /// THINC reconstruction of phi in the cells the interface cuts
     /// (doc/method.md, "A sharp interface inside the cell"): sharpness beta
     /// of the profile 1/2 (1 + tanh(beta (n.xi + d))) in the unit cell; 0:
-    /// off (phi is the DG polynomial everywhere).
-    void set_reconstruction(const double beta, const bool curved = false)
+    /// off (phi is the DG polynomial everywhere). curved: the profile
+    /// follows the curvature of the normals; smoothed_normal (with curved):
+    /// n is the mean of the cell's vertex normals where they agree.
+    void set_reconstruction(const double beta, const bool curved = false,
+                            const bool smoothed_normal = false)
     {
-      thinc_beta   = beta;
-      thinc_curved = curved;
+      thinc_beta     = beta;
+      thinc_curved   = curved;
+      thinc_smoothed = curved && smoothed_normal;
     }
 
     /// With the THINC reconstruction: phi in each interface cell replaced
@@ -208,6 +212,7 @@ namespace Suspension::Solid
 
     double thinc_beta   = 0.;
     bool   thinc_curved = false;
+    bool   thinc_smoothed = false;
     /// the cell mean as a linear functional of the (lexicographic) phi
     /// DoFs of a cell
     std::vector<double> mean_weights;
