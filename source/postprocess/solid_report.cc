@@ -189,10 +189,14 @@ namespace Suspension::Postprocess
         out << "  final: " << describe(solid.particle_shape(space, velocity))
               << std::endl;
         if (const double tolerance = parameters.verification.area_tolerance; tolerance > 0.)
-          out << "  area(phi >= 1/2) against int phi(0), largest deviation over the steps: "
-              << std::fixed << std::setprecision(3) << 100. * largest_area_error << " % <= "
-              << 100. * tolerance << " %: " << (largest_area_error <= tolerance ? "yes" : "no")
-              << std::defaultfloat << std::endl;
+          {
+            // formatted apart, so that out keeps its precision
+            std::ostringstream area;
+            area << "  area(phi >= 1/2) against int phi(0), largest deviation over the steps: "
+                 << std::fixed << std::setprecision(3) << 100. * largest_area_error << " % <= "
+                 << 100. * tolerance << " %: " << (largest_area_error <= tolerance ? "yes" : "no");
+            out << area.str() << std::endl;
+          }
       }
     report_probes(out, time);
     if (!parameters.verification.exact_fraction.empty())
