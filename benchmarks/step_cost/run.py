@@ -32,16 +32,23 @@ WORK = os.path.join(HERE, "work")
 MPI_ENV = dict(os.environ, OMPI_ALLOW_RUN_AS_ROOT="1", OMPI_ALLOW_RUN_AS_ROOT_CONFIRM="1",
                OMP_NUM_THREADS="1")
 
-P = os.path.join(REPO, "parameters")
-# name: (ranks, parameter file, --set entries); every run writes no fields
+# name: (ranks, parameter file in parameters/, --set entries); every run
+# writes no fields. Each code runs the scene file of its own tree: the scene
+# as it was against the scene as it is (a scene may change its
+# discretization, e.g. its DG degree, with the code; the results columns
+# show what that does to the answer).
 SCENES = {
     "main job (2D, 2 ranks)": (
-        2, os.path.join(P, "suspension_channel_2d.prm"), []),
+        2, "suspension_channel_2d.prm", []),
     "3D reduced box, 6 steps (level 3, 2 ranks)": (
-        2, os.path.join(P, "suspension_channel_3d_reduced.prm"),
+        2, "suspension_channel_3d_reduced.prm",
         ["Time stepping/Maximum number of steps=6", "Statistics/Enabled=false"]),
+    "3D reduced box, 3 steps (level 4, 2 ranks)": (
+        2, "suspension_channel_3d_reduced.prm",
+        ["Mesh refinement/Maximum level=4", "Time stepping/Maximum number of steps=3",
+         "Statistics/Enabled=false"]),
     "cavity disc to t = 1 (32 cells per diameter, 1 rank)": (
-        1, os.path.join(P, "disc_cavity_2d.prm"),
+        1, "disc_cavity_2d.prm",
         ["Time stepping/End time=1", "Output/Write phi cells=false"]),
 }
 SECTIONS = ["solid transport", "fluid: momentum right-hand side", "fluid: momentum solve",
@@ -84,7 +91,8 @@ def copy_new():
     return os.path.join(target, "suspension")
 
 
-def run(exe, name, ranks, prm, sets, label):
+def run(exe, tree, name, ranks, prm, sets, label):
+    prm = os.path.join(tree, "parameters", prm)
     out = os.path.join(WORK, "runs", label + "_" + re.sub(r"[^a-z0-9]+", "_", name.lower()))
     os.makedirs(out, exist_ok=True)
     args = [exe, prm, "--set", "Output/Directory=" + os.path.join(out, "output"),
@@ -110,6 +118,15 @@ def run(exe, name, ranks, prm, sets, label):
     row["cells"], row["velocity_dofs"] = (int(m.group(1)), int(m.group(2))) if m else ("", "")
     m = re.search(r"Total wallclock time elapsed since start\s*\|\s*([0-9.e+]+)s", text)
     row["solver_s"] = float(m.group(1)) if m else ""
+    # the steady step: solver time without the set-up, per step
+    m = re.search(r"Maximum number of steps=(\d+)", " ".join(sets))
+    row["s_per_step"] = (round((row["solver_s"] - float(re.search(
+        r"\|\s*setup \(mesh, DoFs, matrices\)\s*\|\s*\d+\s*\|\s*([0-9.e+]+)s", text).group(1)))
+        / int(m.group(1)), 3) if m and row["solver_s"] != "" else "")
+    m = re.search(r"Memory: peak resident .*?, ([0-9.]+) kB per velocity DoF", text)
+    row["kB_per_velocity_dof"] = float(m.group(1)) if m else ""
+    m = re.search(r"elastic energy where phi < 1/2: ([0-9.e+-]+) %", text)
+    row["tail_energy_percent"] = m.group(1) if m else ""
     for section in SECTIONS:
         m = re.search(r"\|\s*" + re.escape(section) + r"\s*\|\s*(\d+)\s*\|\s*([0-9.e+]+)s", text)
         row[section] = float(m.group(2)) if m else 0.
@@ -121,19 +138,22 @@ def run(exe, name, ranks, prm, sets, label):
 def table(rows):
     by = {(r["scene"], r["code"]): r for r in rows}
     print(f"{'scene':52s} {'':5s} {'wall s':>8s} {'solver s':>9s} {'transport':>9s} "
-          f"{'peak MB':>8s}")
+          f"{'peak MB':>8s} {'s/step':>7s} {'kB/vDoF':>7s}")
+    num = lambda r, k: float(r[k]) if r.get(k) not in (None, "") else float("nan")
     for scene in dict.fromkeys(r["scene"] for r in rows):
         for code in ("old", "new"):
             r = by.get((scene, code))
             if r:
                 print(f"{scene:52s} {code:5s} {float(r['wall_s']):8.1f} {float(r['solver_s'] or 0):9.1f} "
                       f"{float(r['solid transport']):9.1f} {float(r['peak_MB']):8.0f}"
+                      f" {num(r, 's_per_step'):7.2f} {num(r, 'kB_per_velocity_dof'):7.2f}"
                       + (f"  mu_eff {r['mu_eff']}, N1 {r['N1']}, N2 {r['N2']}" if r.get("mu_eff") else ""))
         if (scene, "old") in by and (scene, "new") in by:
             o, n = by[(scene, "old")], by[(scene, "new")]
-            ratio = lambda k: float(n[k]) / float(o[k]) if float(o[k] or 0) > 0 else float("nan")
+            ratio = lambda k: num(n, k) / num(o, k) if num(o, k) > 0 else float("nan")
             print(f"{'':52s} {'ratio':5s} {ratio('wall_s'):8.2f} {ratio('solver_s'):9.2f} "
-                  f"{ratio('solid transport'):9.2f} {ratio('peak_MB'):8.2f}")
+                  f"{ratio('solid transport'):9.2f} {ratio('peak_MB'):8.2f} "
+                  f"{ratio('s_per_step'):7.2f} {ratio('kB_per_velocity_dof'):7.2f}")
 
 
 def chart(rows):
@@ -166,12 +186,13 @@ def main():
     else:
         os.makedirs(WORK, exist_ok=True)
         exes = {"old": build_old(a.old), "new": copy_new()}
+        trees = {"old": os.path.join(WORK, "old"), "new": REPO}
         chosen = [s for s in SCENES if not a.scenes or any(k in s for k in a.scenes.split(","))]
         rows = []
         for name in chosen:
             ranks, prm, sets = SCENES[name]
             for label in ("old", "new"):
-                rows.append(run(exes[label], name, ranks, prm, sets, label))
+                rows.append(run(exes[label], trees[label], name, ranks, prm, sets, label))
                 print(f"  {name} [{label}]: {rows[-1]['wall_s']} s", flush=True)
         fields = list(rows[0].keys())
         with open(csv_path, "w", newline="") as f:

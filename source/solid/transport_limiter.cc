@@ -134,11 +134,11 @@ namespace Suspension::Solid
       return 0;
     unsigned int                          n_limited = 0;
     FEEvaluation<dim, -1, 0, n_B, double> b(matrix_free, 0, 0, 1);
-    const auto smallest = [](const Tensor<1, n_B, VA> &t, const unsigned int v) {
+    const auto tensor = [](const Tensor<1, n_B, VA> &t, const unsigned int v) {
       SymmetricTensor<2, dim> B;
       for (unsigned int c = 0; c < n_B; ++c)
         B[SymmetricTensor<2, dim>::unrolled_to_component_indices(c)] = t[c][v];
-      return smallest_eigenvalue(B);
+      return B;
     };
     for (unsigned int cell = 0; cell < matrix_free.n_cell_batches(); ++cell)
       {
@@ -158,25 +158,29 @@ namespace Suspension::Solid
                 volume += b.JxW(q)[v];
               }
             mean /= volume;
-            const double lambda_mean = smallest(mean, v);
+            const double lambda_mean = smallest_eigenvalue(tensor(mean, v));
             if (!(lambda_mean > 0.))
               continue; // nothing a scaling can do; the SPD check reports it
             // keep at least a tenth of the mean's smallest eigenvalue
             const double floor = 0.1 * lambda_mean;
             double       theta = 1.;
-            const auto   consider = [&](const double lambda) {
+            const auto   consider = [&](const Tensor<1, n_B, VA> &value) {
+              const SymmetricTensor<2, dim> B = tensor(value, v);
+              if (eigenvalues_exceed(B, floor)) // nearly always: no eigensolver
+                return;
+              const double lambda = smallest_eigenvalue(B);
               if (lambda < floor)
                 theta = std::min(theta, (lambda_mean - floor) / (lambda_mean - lambda));
             };
             for (const unsigned int q : b.quadrature_point_indices())
-              consider(smallest(b.get_value(q), v));
+              consider(b.get_value(q));
             const unsigned int n_nodes = b.dofs_per_component;
             for (unsigned int i = 0; i < n_nodes; ++i)
               {
                 Tensor<1, n_B, VA> node;
                 for (unsigned int c = 0; c < n_B; ++c)
                   node[c] = b.begin_dof_values()[c * n_nodes + i];
-                consider(smallest(node, v));
+                consider(node);
               }
             if (theta < 1.)
               {

@@ -37,6 +37,35 @@ namespace Suspension::Solid
       return eigenvectors(t, SymmetricTensorEigenvectorMethod::jacobi)[dim - 1].first;
   }
 
+  /**
+   * Whether every eigenvalue of t certainly exceeds `floor`: Sylvester's
+   * criterion (all leading principal minors positive) for t - f I, with f
+   * raised by a round-off margin, so that a true answer agrees with
+   * smallest_eigenvalue(t) > floor. A few products instead of an
+   * eigensolver: the B limiter asks this at every node and quadrature point
+   * of every solid cell and stage, where nearly all answers are true (in 3D
+   * the Jacobi eigensolver took a third of a step's time).
+   */
+  template <int dim>
+  bool eigenvalues_exceed(const SymmetricTensor<2, dim> &t, const double floor)
+  {
+    const double f   = floor + 1e-12 * std::abs(trace(t));
+    const double a00 = t[0][0] - f, a11 = t[1][1] - f;
+    const double m2  = a00 * a11 - t[0][1] * t[0][1];
+    if (!(a00 > 0.) || !(m2 > 0.))
+      return false;
+    if constexpr (dim == 2)
+      return true;
+    else
+      {
+        const double a22 = t[2][2] - f;
+        const double m3  = a00 * (a11 * a22 - t[1][2] * t[1][2]) -
+                          t[0][1] * (t[0][1] * a22 - t[1][2] * t[0][2]) +
+                          t[0][2] * (t[0][1] * t[1][2] - a11 * t[0][2]);
+        return m3 > 0.;
+      }
+  }
+
   /// Smallest and largest values seen by the limiter, and its work.
   struct LimiterReport
   {
