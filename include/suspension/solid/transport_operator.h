@@ -49,21 +49,11 @@ namespace Suspension::Solid
   template <int dim>
   bool eigenvalues_exceed(const SymmetricTensor<2, dim> &t, const double floor)
   {
-    const double f   = floor + 1e-12 * std::abs(trace(t));
-    const double a00 = t[0][0] - f, a11 = t[1][1] - f;
-    const double m2  = a00 * a11 - t[0][1] * t[0][1];
-    if (!(a00 > 0.) || !(m2 > 0.))
+    const SymmetricTensor<2, dim> a =
+      t - (floor + 1e-12 * std::abs(trace(t))) * unit_symmetric_tensor<dim>();
+    if (!(a[0][0] > 0.) || !(a[0][0] * a[1][1] - a[0][1] * a[0][1] > 0.))
       return false;
-    if constexpr (dim == 2)
-      return true;
-    else
-      {
-        const double a22 = t[2][2] - f;
-        const double m3  = a00 * (a11 * a22 - t[1][2] * t[1][2]) -
-                          t[0][1] * (t[0][1] * a22 - t[1][2] * t[0][2]) +
-                          t[0][2] * (t[0][1] * t[1][2] - a11 * t[0][2]);
-        return m3 > 0.;
-      }
+    return dim == 2 || determinant(a) > 0.;
   }
 
   /// Smallest and largest values seen by the limiter, and its work.
