@@ -13,18 +13,21 @@ namespace Suspension
 {
   namespace
   {
-    /// Peak resident memory per active cell, measured on uniform meshes of
-    /// the channel scenes over three steps (the slope of VmHWM between 768
-    /// and 49 152 cells in 2D, 4 096 and 32 768 in 3D; doc/performance.md,
-    /// "Memory"): the fluid's matrices and vectors (Q2-Q1) and, with a
-    /// solid, its DG fields. Adaptive runs need more (hanging-node
-    /// constraints, the transfer at mesh changes): this is a lower bound.
-    double bytes_per_cell(const Parameters::All &p)
+    /// Peak resident memory per active cell (doc/performance.md, "Memory";
+    /// re-measured in session 22 on the matrix-free code): the slope of
+    /// VmHWM over uniform meshes of the channel scenes, three steps each,
+    /// and on adaptive meshes (refined towards the particles, hanging-node
+    /// constraints, the transfer at mesh changes) the peak of a run over
+    /// its cells less the base.
+    constexpr double BYTES_2D_FLUID = 8.5e3, BYTES_2D_SOLID = 10.4e3, BYTES_2D_REFINED = 20e3;
+    constexpr double BYTES_3D_FLUID = 71e3, BYTES_3D_SOLID = 85e3, BYTES_3D_REFINED = 25e3;
+
+    double bytes_per_cell(const Parameters::All &p, const bool refined)
     {
       const bool solid = p.solid.enabled();
       if (p.dimension == 2)
-        return solid ? 10.4e3 : 8.5e3;
-      return solid ? 85.e3 : 71.e3;
+        return refined ? BYTES_2D_REFINED : (solid ? BYTES_2D_SOLID : BYTES_2D_FLUID);
+      return refined ? BYTES_3D_REFINED : (solid ? BYTES_3D_SOLID : BYTES_3D_FLUID);
     }
 
     /// What a rank holds before its mesh: the code and the libraries (the
@@ -44,27 +47,46 @@ namespace Suspension
       return out.str();
     }
 
-    /// MemAvailable of /proc/meminfo in bytes; 0 if unknown.
+    /// The memory limit of this process's control group (what a batch
+    /// system such as Slurm grants a job, often less than the node has):
+    /// cgroup v2's memory.max or v1's memory.limit_in_bytes, in bytes; 0 if
+    /// there is none.
+    double cgroup_limit()
+    {
+      for (const char *file : {"/sys/fs/cgroup/memory.max", "/sys/fs/cgroup/memory/memory.limit_in_bytes"})
+        {
+          std::ifstream in(file);
+          double        bytes = 0.;
+          if (in >> bytes && bytes > 0. && bytes < 1e18) // "max" or 2^63: none
+            return bytes;
+        }
+      return 0.;
+    }
+
+    /// MemAvailable of /proc/meminfo, or the control group's limit if that
+    /// is smaller, in bytes; 0 if unknown.
     double available_memory()
     {
       std::ifstream meminfo("/proc/meminfo");
       std::string   key;
       double        kB;
       std::string   unit;
+      double        available = 0.;
       while (meminfo >> key >> kB >> unit)
         if (key == "MemAvailable:")
-          return kB * 1024.;
-      return 0.;
+          available = kB * 1024.;
+      const double limit = cgroup_limit();
+      return limit > 0. && (available <= 0. || limit < available) ? limit : available;
     }
   } // namespace
 
-  MemoryEstimate estimate_memory(const Parameters::All &p, MPI_Comm communicator)
+  MemoryEstimate estimate_memory(const Parameters::All &p, const double cells,
+                                 MPI_Comm communicator)
   {
     MemoryEstimate e;
-    e.cells = std::pow(2., double(p.dimension * p.mesh.global_refinements));
-    for (const unsigned int n : p.geometry.subdivisions)
-      e.cells *= n;
-    e.bytes_per_cell = bytes_per_cell(p);
+    e.cells          = cells;
+    e.refined        = p.mesh_refinement.enabled;
+    e.bytes_per_cell = bytes_per_cell(p, e.refined);
     const unsigned int ranks = dealii::Utilities::MPI::n_mpi_processes(communicator);
     e.bytes_per_rank = base_bytes + e.cells / ranks * e.bytes_per_cell;
     MPI_Comm node;
@@ -77,20 +99,56 @@ namespace Suspension
     return e;
   }
 
+  MemoryEstimate estimate_memory(const Parameters::All &p, MPI_Comm communicator)
+  {
+    double cells = std::pow(2., double(p.dimension * p.mesh.global_refinements));
+    for (const unsigned int n : p.geometry.subdivisions)
+      cells *= n;
+    MemoryEstimate e = estimate_memory(p, cells, communicator);
+    // the coarse mesh is uniform: its cost per cell is that of a uniform mesh
+    e.refined        = false;
+    e.bytes_per_cell = bytes_per_cell(p, false);
+    e.bytes_per_rank = base_bytes + e.cells / dealii::Utilities::MPI::n_mpi_processes(communicator) *
+                                      e.bytes_per_cell;
+    return e;
+  }
+
+  namespace
+  {
+    std::string does_not_fit(const MemoryEstimate &e, MPI_Comm communicator)
+    {
+      std::ostringstream message;
+      message << "make " << std::setprecision(3) << e.cells << " cells, which need about "
+              << in_units(e.bytes_per_rank) << " per rank on "
+              << dealii::Utilities::MPI::n_mpi_processes(communicator) << " rank(s) ("
+              << std::setprecision(2) << e.bytes_per_cell / 1e3 << " kB per "
+              << (e.refined ? "cell of an adaptive mesh" : "cell") << ", measured); the "
+              << e.ranks_on_node << " rank(s) on a node have " << in_units(e.available_per_rank)
+              << " available each: lower it or run on more nodes (mpirun -np N)";
+      return message.str();
+    }
+  } // namespace
+
   void check_memory(const Parameters::All &p, MPI_Comm communicator)
   {
     const MemoryEstimate e = estimate_memory(p, communicator);
     if (e.available_per_rank <= 0. || e.bytes_per_rank <= e.available_per_rank)
       return;
-    std::ostringstream message;
-    message << p.mesh.global_refinements << " refinements make " << std::setprecision(3)
-            << e.cells << " cells, which need about " << in_units(e.bytes_per_rank)
-            << " per rank on " << dealii::Utilities::MPI::n_mpi_processes(communicator)
-            << " rank(s) (" << std::setprecision(2) << e.bytes_per_cell / 1e3
-            << " kB per cell, measured); the " << e.ranks_on_node
-            << " rank(s) on a node have " << in_units(e.available_per_rank)
-            << " available each: lower it or run on more nodes (mpirun -np N)";
-    throw Parameters::InputError("Mesh/Global refinements", message.str());
+    throw Parameters::InputError("Mesh/Global refinements",
+                                 std::to_string(p.mesh.global_refinements) + " refinements " +
+                                   does_not_fit(e, communicator));
+  }
+
+  void check_memory_of_refined_mesh(const Parameters::All &p, const double cells,
+                                    MPI_Comm communicator)
+  {
+    const MemoryEstimate e = estimate_memory(p, cells, communicator);
+    if (e.available_per_rank <= 0. || e.bytes_per_rank <= e.available_per_rank)
+      return;
+    throw Parameters::InputError("Mesh refinement/Maximum level",
+                                 "the initial refinement towards the particles to level " +
+                                   std::to_string(p.mesh_refinement.maximum_level) + " would " +
+                                   does_not_fit(e, communicator));
   }
 
   double peak_resident_memory()

@@ -81,36 +81,43 @@ namespace Suspension
   void Simulation<dim>::setup()
   {
     TimerOutput::Scope scope(timer, "setup (mesh, DoFs, matrices)");
-    create_initial_mesh();
-    space.setup(scene);
+    const bool fields_on_mesh = create_initial_mesh();
+    if (!fields_on_mesh)
+      space.setup(scene);
     // a prescribed velocity needs the velocity space, but no matrix
     if (!prescribed_velocity)
       operators.reinit(space);
     fluid.initialize(prescribed_velocity.get());
-    if (solid)
+    if (solid && !fields_on_mesh)
       solid->setup(space, adaptor.finest_cell_size());
     smallest_cell_size = smallest_cell();
+    initial_memory_estimate =
+      estimate_memory(parameters, triangulation.n_global_active_cells(), communicator).bytes_per_rank;
   }
 
   template <int dim>
-  void Simulation<dim>::create_initial_mesh()
+  bool Simulation<dim>::create_initial_mesh()
   {
     scene.create_mesh(triangulation);
     if (!adaptor.enabled())
-      return;
+      return false;
     // Refine towards the initial interface: set phi on the current mesh,
-    // flag, refine, and again, until nothing changes.
+    // flag, refine, and again, until nothing changes; the space and the
+    // solid of the last cycle are those of the final mesh (not built twice).
     for (unsigned int cycle = 0; cycle < parameters.mesh_refinement.initial_cycles; ++cycle)
       {
         space.setup(scene);
         if (solid)
           solid->setup(space, adaptor.finest_cell_size());
         if (!adaptor.flag(solid.get(), space, nullptr, 0.))
-          break;
+          return true;
         triangulation.execute_coarsening_and_refinement();
         while (adaptor.flag_periodic_hanging_faces())
           triangulation.execute_coarsening_and_refinement();
+        // before the refined mesh's fields are built
+        check_memory_of_refined_mesh(parameters, triangulation.n_global_active_cells(), communicator);
       }
+    return false;
   }
 
   template <int dim>

@@ -59,6 +59,9 @@ namespace Suspension
                                "' (dimension, coarse cells, elements): resume with the file "
                                "the checkpoint was written with");
     checkpoint.load_mesh(triangulation);
+    // for the run summary: the checkpoint's mesh on the ranks of this run
+    initial_memory_estimate =
+      estimate_memory(parameters, triangulation.n_global_active_cells(), communicator).bytes_per_rank;
     space.setup(scene);
     if (!prescribed_velocity)
       operators.reinit(space);

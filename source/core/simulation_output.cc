@@ -205,9 +205,22 @@ namespace Suspension
 
     if (parameters.output.timer_summary)
       pcout << "  "
-            << memory_line(space.dof_velocity.n_dofs(),
-                           estimate_memory(parameters, communicator).bytes_per_rank, communicator)
+            << memory_line(space.dof_velocity.n_dofs(), initial_memory_estimate, communicator)
             << std::endl;
+    if (parameters.output.timer_summary && solid)
+      {
+        // where the solid's share goes (the largest rank's), the part that
+        // issue 14 cut: MatrixFree without quadrature points, no scratch
+        // vectors of all DoFs for the exchange of the profiles
+        std::ostringstream line;
+        line << "  of which the solid (MB, largest rank):" << std::fixed << std::setprecision(0);
+        for (const auto &[name, bytes] : solid->memory_by_part())
+          line << " " << name.substr(name.find(' ') + 1) << " "
+               << Utilities::MPI::max(double(bytes), communicator) / 1e6 << ",";
+        std::string text = line.str();
+        text.pop_back();
+        pcout << text << std::endl;
+      }
 
     RunSummary summary;
     summary.final_errors = verification_report.last_errors();

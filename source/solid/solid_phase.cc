@@ -140,6 +140,18 @@ namespace Suspension::Solid
   }
 
   template <int dim>
+  std::vector<std::pair<std::string, std::size_t>> SolidPhase<dim>::memory_by_part() const
+  {
+    const std::size_t matrix_free = transport.matrix_free_memory();
+    return {{"solid DoFs", dof_handler.memory_consumption()},
+            {"solid MatrixFree", matrix_free},
+            {"solid transport data", transport.memory_consumption() - matrix_free},
+            {"solid fields", solution.memory_consumption() + stage.memory_consumption() +
+                               stage_rhs.memory_consumption() + u0.memory_consumption() +
+                               u1.memory_consumption() + u_stage.memory_consumption()}};
+  }
+
+  template <int dim>
   void SolidPhase<dim>::setup(const Fluid::FluidSpace<dim> &fluid_space, const double interface_h)
   {
     reinit_discretization(fluid_space);

@@ -114,13 +114,11 @@ namespace Suspension::Solid
     const unsigned int n_owned  = matrix_free.n_cell_batches();
     const unsigned int n_ghosts = matrix_free.n_ghost_cell_batches();
     const unsigned int n_dofs   = mean_weights.size();
-    // the DoF indices of phi in a cell (lexicographic, as FE_DGQ numbers
-    // them), global and local to the vectors of the MatrixFree
-    const types::global_dof_index *phi_indices = nullptr;
-    const unsigned int            *phi_local   = nullptr;
-    const auto phi_dofs = [&](const unsigned int cell, const unsigned int v) {
-      phi_indices = &lane_phi_dofs[(cell * n_lanes + v) * n_dofs];
-      phi_local   = &lane_phi_local[(cell * n_lanes + v) * n_dofs];
+    // what the neighbours on other ranks receive: value j of a lane's cell
+    const bool exchange = !ghost_layer_volume.empty();
+    const auto cell_value = [&](const unsigned int j, const unsigned int cell,
+                                const unsigned int v) -> double & {
+      return cell_exchange[j](lane_global_cell[cell * n_lanes + v]);
     };
 
     // 1. cell means
@@ -153,22 +151,22 @@ namespace Suspension::Solid
             }
         }
     // the ghost layer (all cells that share a vertex with an owned one)
-    if (!ghost_layer_volume.empty())
+    if (exchange)
       {
-        ghost_layer_values.copy_locally_owned_data_from(src);
-        ghost_layer_values.update_ghost_values();
+        for (unsigned int cell = 0; cell < n_owned; ++cell)
+          for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+            cell_value(0, cell, v) = cell_mean[cell * n_lanes + v];
+        cell_exchange[0].update_ghost_values();
         for (std::size_t g = 0; g < ghost_layer_volume.size(); ++g)
           {
-            double mean = 0.;
-            for (unsigned int i = 0; i < n_dofs; ++i)
-              mean += mean_weights[i] * ghost_layer_values(ghost_layer_dofs[g * n_dofs + i]);
+            const double mean = cell_exchange[0](ghost_layer_cells[g]);
             for (unsigned int i = 0; i < n_vertices; ++i)
               {
                 vertex_mean[ghost_layer_vertices[g * n_vertices + i]] += ghost_layer_volume[g] * mean;
                 vertex_weight[ghost_layer_vertices[g * n_vertices + i]] += ghost_layer_volume[g];
               }
           }
-        ghost_layer_values.zero_out_ghost_values();
+        cell_exchange[0].zero_out_ghost_values();
       }
 
     // the gradient (integral over the unit cell) of an owned cell
@@ -195,9 +193,9 @@ namespace Suspension::Solid
           for (unsigned int i = 0; i < n_vertices; ++i)
             vertex_normal[vertices[i]] += volume * normal;
         };
-        const bool exchange = !ghost_layer_volume.empty();
         if (exchange)
-          normal_values = 0.;
+          for (unsigned int c = 0; c < dim; ++c)
+            cell_exchange[c] = 0.;
         for (unsigned int cell = 0; cell < n_owned; ++cell)
           for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
             {
@@ -210,24 +208,23 @@ namespace Suspension::Solid
               const Tensor<1, dim> normal = g / g.norm();
               add_to_vertices(&cell_vertices[k * n_vertices], cell_volume[k], normal);
               if (exchange)
-                {
-                  phi_dofs(cell, v);
-                  for (unsigned int c = 0; c < dim; ++c)
-                    normal_values(phi_indices[c]) = normal[c];
-                }
+                for (unsigned int c = 0; c < dim; ++c)
+                  cell_value(c, cell, v) = normal[c];
             }
         if (exchange)
           {
-            normal_values.update_ghost_values();
+            for (unsigned int c = 0; c < dim; ++c)
+              cell_exchange[c].update_ghost_values();
             for (std::size_t g = 0; g < ghost_layer_volume.size(); ++g)
               {
                 Tensor<1, dim> normal;
                 for (unsigned int c = 0; c < dim; ++c)
-                  normal[c] = normal_values(ghost_layer_dofs[g * n_dofs + c]);
+                  normal[c] = cell_exchange[c](ghost_layer_cells[g]);
                 if (normal.norm() > 0.)
                   add_to_vertices(&ghost_layer_vertices[g * n_vertices], ghost_layer_volume[g], normal);
               }
-            normal_values.zero_out_ghost_values();
+            for (unsigned int c = 0; c < dim; ++c)
+              cell_exchange[c].zero_out_ghost_values();
           }
       }
     const auto divergence_of_normals = [&](const unsigned int k) {
@@ -287,40 +284,34 @@ namespace Suspension::Solid
         }
     if (n_ghosts == 0)
       return;
-    ghosted = 0.;
-    if (thinc_curved)
-      ghosted_curvature = 0.;
+    for (auto &values : cell_exchange)
+      values = 0.;
     for (unsigned int cell = 0; cell < n_owned; ++cell)
       for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
         if (const auto &r = reconstruction[cell][v]; r.weight > 0.)
           {
-            phi_dofs(cell, v);
-            if (thinc_curved)
-              ghosted_curvature.local_element(phi_local[0]) = r.curvature;
-            ghosted.local_element(phi_local[0]) = r.weight;
-            ghosted.local_element(phi_local[1]) = r.offset;
+            cell_value(0, cell, v) = r.weight;
+            cell_value(1, cell, v) = r.offset;
             for (unsigned int c = 0; c < dim; ++c)
-              ghosted.local_element(phi_local[2 + c]) = r.slope[c];
+              cell_value(2 + c, cell, v) = r.slope[c];
+            cell_value(2 + dim, cell, v) = r.curvature;
           }
-    ghosted.update_ghost_values();
-    if (thinc_curved)
-      ghosted_curvature.update_ghost_values();
+    for (auto &values : cell_exchange)
+      values.update_ghost_values();
     for (unsigned int cell = n_owned; cell < n_owned + n_ghosts; ++cell)
       for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
         {
-          phi_dofs(cell, v);
-          auto &r  = reconstruction[cell][v];
-          r.lower  = cell_corner[cell * n_lanes + v];
-          r.upper  = cell_corner[cell * n_lanes + v] + cell_extent[cell * n_lanes + v];
-          r.weight    = ghosted.local_element(phi_local[0]);
-          r.curvature = thinc_curved ? ghosted_curvature.local_element(phi_local[0]) : 0.;
-          r.offset = ghosted.local_element(phi_local[1]);
+          auto &r     = reconstruction[cell][v];
+          r.lower     = cell_corner[cell * n_lanes + v];
+          r.upper     = cell_corner[cell * n_lanes + v] + cell_extent[cell * n_lanes + v];
+          r.weight    = cell_value(0, cell, v);
+          r.offset    = cell_value(1, cell, v);
           for (unsigned int c = 0; c < dim; ++c)
-            r.slope[c] = ghosted.local_element(phi_local[2 + c]);
+            r.slope[c] = cell_value(2 + c, cell, v);
+          r.curvature = cell_value(2 + dim, cell, v);
         }
-    ghosted.zero_out_ghost_values();
-    if (thinc_curved)
-      ghosted_curvature.zero_out_ghost_values();
+    for (auto &values : cell_exchange)
+      values.zero_out_ghost_values();
   }
 
   template <int dim>
@@ -376,7 +367,7 @@ namespace Suspension::Solid
           old_dofs[i] = phi.begin_dof_values()[i];
         phi.evaluate(EvaluationFlags::values);
         for (const unsigned int q : phi.quadrature_point_indices())
-          values[q] = seen_phi<dim>(reconstruction[cell], phi.quadrature_point(q), phi.get_value(q));
+          values[q] = seen_phi<dim>(reconstruction[cell], cell_point(cell, 1, q), phi.get_value(q));
         inverse.transform_from_q_points_to_basis(1, values.data(), phi.begin_dof_values());
         for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
           {
@@ -398,8 +389,10 @@ namespace Suspension::Solid
   template <int dim>
   double TransportOperator<dim>::face_jumps(const VectorType &solution, const double touches) const
   {
-    face_scratch.copy_locally_owned_data_from(solution);
-    face_scratch.update_ghost_values();
+    // the face neighbours' values in the solution's own ghost entries
+    const bool had_ghosts = solution.has_ghost_elements();
+    if (!had_ghosts)
+      solution.update_ghost_values();
     // quadrature 1: k + 1 Gauss points
     FEFaceEvaluation<dim, -1, 0, 1, double> phi_m(matrix_free, true, 0, 1, 0);
     FEFaceEvaluation<dim, -1, 0, 1, double> phi_p(matrix_free, false, 0, 1, 0);
@@ -416,8 +409,8 @@ namespace Suspension::Solid
         phi_m.reinit(face);
         phi_p.reinit(face);
         // the whole cells' values: the touch test reads every node
-        phi_m.read_dof_values(face_scratch);
-        phi_p.read_dof_values(face_scratch);
+        phi_m.read_dof_values(solution);
+        phi_p.read_dof_values(solution);
         bool any = false;
         std::array<bool, VA::size()> counts{};
         for (unsigned int v = 0; v < matrix_free.n_active_entries_per_face_batch(face); ++v)
@@ -435,7 +428,8 @@ namespace Suspension::Solid
             for (const unsigned int q : phi_m.quadrature_point_indices())
               total += std::abs(phi_m.get_value(q)[v] - phi_p.get_value(q)[v]) * phi_m.JxW(q)[v];
       }
-    face_scratch.zero_out_ghost_values();
+    if (!had_ghosts)
+      solution.zero_out_ghost_values();
     return total;
   }
 

@@ -80,7 +80,7 @@ namespace Suspension::Solid
             profile = phi.read_cell_data(reconstruction);
           for (const unsigned int q : phi.quadrature_point_indices())
             {
-              const VA phi_q = thinc ? seen_phi<dim>(profile, phi.quadrature_point(q), phi.get_value(q)) :
+              const VA phi_q = thinc ? seen_phi<dim>(profile, cell_point(cell, 0, q), phi.get_value(q)) :
                                        phi.get_value(q);
               Tensor<1, dim, VA> flux = u.get_value(q) * phi_q;
               if (compress)
@@ -148,8 +148,8 @@ namespace Suspension::Solid
               const auto &n    = phi_m.get_normal_vector(q);
               const VA    un   = u.get_value(q) * n;
               VA          flux = thinc ? upwind(un,
-                                       seen_phi<dim>(profile_m, phi_m.quadrature_point(q), phi_m.get_value(q)),
-                                       seen_phi<dim>(profile_p, phi_m.quadrature_point(q), phi_p.get_value(q))) :
+                                       seen_phi<dim>(profile_m, face_point(face, q), phi_m.get_value(q)),
+                                       seen_phi<dim>(profile_p, face_point(face, q), phi_p.get_value(q))) :
                                 upwind(un, phi_m.get_value(q), phi_p.get_value(q));
               if (compress)
                 {
@@ -231,7 +231,7 @@ namespace Suspension::Solid
           for (const unsigned int q : phi.quadrature_point_indices())
             {
               const VA un   = u.get_value(q) * phi.get_normal_vector(q);
-              const VA phi_q = thinc ? seen_phi<dim>(profile, phi.quadrature_point(q), phi.get_value(q)) :
+              const VA phi_q = thinc ? seen_phi<dim>(profile, face_point(face, q), phi.get_value(q)) :
                                        phi.get_value(q);
               const VA flux = upwind(un, phi_q, VA(0.));
               phi.submit_value(-flux, q);

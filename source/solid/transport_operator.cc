@@ -1,10 +1,13 @@
 // TransportOperator: set-up on a mesh (MatrixFree data, the lanes of the
 // interface cells, vectors) and the marking of the cells that carry B.
 #include <deal.II/base/bounding_box.h>
+#include <deal.II/base/memory_consumption.h>
 #include <deal.II/base/mpi.h>
 #include <deal.II/base/utilities.h>
 #include <deal.II/base/symmetric_tensor.h>
+#include <deal.II/distributed/tria_base.h>
 #include <deal.II/dofs/dof_tools.h>
+#include <deal.II/base/qprojector.h>
 #include <deal.II/fe/mapping_q1.h>
 #include <deal.II/grid/grid_tools.h>
 #include <deal.II/matrix_free/fe_evaluation.h>
@@ -37,13 +40,12 @@ namespace Suspension::Solid
 
     typename MatrixFree<dim, double>::AdditionalData data;
     data.tasks_parallel_scheme = MatrixFree<dim, double>::AdditionalData::none;
-    data.mapping_update_flags =
-      update_values | update_gradients | update_JxW_values | update_quadrature_points;
-    data.mapping_update_flags_inner_faces = update_values | update_gradients |
-                                            update_JxW_values | update_normal_vectors |
-                                            update_quadrature_points;
+    // no quadrature points: cell_point() and face_point() compute them
+    data.mapping_update_flags = update_values | update_gradients | update_JxW_values;
+    data.mapping_update_flags_inner_faces =
+      update_values | update_gradients | update_JxW_values | update_normal_vectors;
     data.mapping_update_flags_boundary_faces =
-      update_values | update_JxW_values | update_normal_vectors | update_quadrature_points;
+      update_values | update_JxW_values | update_normal_vectors;
 
     const AffineConstraints<double> no_constraints;
     const std::vector<const DoFHandler<dim> *>           dofs = {&dof_solid, &dof_velocity};
@@ -52,6 +54,12 @@ namespace Suspension::Solid
     // quadrature 0: integrals; 1: k+1 Gauss points for the inverse mass
     const std::vector<Quadrature<1>> quadratures = {QGauss<1>(n_q), QGauss<1>(k + 1)};
     matrix_free.reinit(MappingQ1<dim>(), dofs, constraints, quadratures, data);
+    for (unsigned int i = 0; i < 2; ++i)
+      unit_cell_points[i] = QGauss<dim>(quadratures[i].size()).get_points();
+    for (const unsigned int f : GeometryInfo<dim>::face_indices())
+      unit_face_points[f] = QProjector<dim>::project_to_face(ReferenceCells::get_hypercube<dim>(),
+                                                             QGauss<dim - 1>(n_q), f)
+                              .get_points();
 
     // B everywhere until mark_solid_cells() says where
     const unsigned int n_batches = matrix_free.n_cell_batches() + matrix_free.n_ghost_cell_batches();
@@ -78,7 +86,6 @@ namespace Suspension::Solid
           const auto [cell, face_no] = matrix_free.get_face_iterator(face, v, true);
           periodic_face_lane[face * VectorizedArray<double>::size() + v] = cell->at_boundary(face_no);
         }
-    matrix_free.initialize_dof_vector(face_scratch, 0);
 
     // cell sizes for the interface diffusion: a cell's smallest vertex
     // distance, a face's the smaller of its two cells'
@@ -144,30 +151,13 @@ namespace Suspension::Solid
               for (unsigned int d = 0; d < dim; ++d)
                 cell_extent[cell * n_lanes + v][d] = box.side_length(d);
             }
-        // the phi DoFs of every lane (global, and local to the MatrixFree's
-        // vectors), for the exchange of the profiles with the ghost cells
-        {
-          const FiniteElement<dim>            &fe = dof_solid.get_fe();
-          const auto                           partitioner = matrix_free.get_vector_partitioner(0);
-          std::vector<types::global_dof_index> indices(fe.n_dofs_per_cell());
-          const unsigned int                   n_phi = base.n_dofs_per_cell();
-          lane_phi_dofs.assign(n_cells * n_lanes * n_phi, 0);
-          lane_phi_local.assign(n_cells * n_lanes * n_phi, 0);
-          for (unsigned int cell = 0; cell < n_cells; ++cell)
-            for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
-              {
-                matrix_free.get_cell_iterator(cell, v)->get_dof_indices(indices);
-                for (unsigned int i = 0; i < indices.size(); ++i)
-                  {
-                    const auto [component, index] = fe.system_to_component_index(i);
-                    if (component != 0)
-                      continue;
-                    const std::size_t k = (cell * n_lanes + v) * n_phi + index;
-                    lane_phi_dofs[k]    = indices[i];
-                    lane_phi_local[k]   = partitioner->global_to_local(indices[i]);
-                  }
-              }
-        }
+        // the global index of every lane's cell, for the exchange with
+        // the neighbours on other ranks
+        lane_global_cell.assign(n_cells * n_lanes, numbers::invalid_unsigned_int);
+        for (unsigned int cell = 0; cell < n_cells; ++cell)
+          for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+            lane_global_cell[cell * n_lanes + v] =
+              matrix_free.get_cell_iterator(cell, v)->global_active_cell_index();
         // vertices across periodic faces are one vertex for the averages
         // (a particle that crosses the channel's periodic ends keeps its
         // normals): union of the matching vertices of periodic face pairs
@@ -206,48 +196,82 @@ namespace Suspension::Solid
 
         matrix_free.initialize_cell_data_vector(reconstruction);
         cell_mean.assign(n_cells * n_lanes, 0.);
-        if (matrix_free.n_ghost_cell_batches() > 0)
-          matrix_free.initialize_dof_vector(ghosted, 0);
-        if (matrix_free.n_ghost_cell_batches() > 0 && thinc_curved)
-          matrix_free.initialize_dof_vector(ghosted_curvature, 0);
         vertex_normal.assign(thinc_curved ? vertex_mean.size() : 0, Tensor<1, dim>());
 
         // Youngs' normal of an owned cell needs the means of all cells that
         // share a vertex with it; MatrixFree's ghost cells are only those
         // across faces, so the ghost layer of the mesh is listed here (its
-        // vertices, volumes and phi DoFs), read from a vector with all
-        // locally relevant DoFs
+        // vertices, volumes and cell indices)
         ghost_layer_vertices.clear();
         ghost_layer_volume.clear();
-        ghost_layer_dofs.clear();
-        std::vector<types::global_dof_index> indices(dof_solid.get_fe().n_dofs_per_cell());
+        ghost_layer_cells.clear();
         for (const auto &cell : dof_solid.active_cell_iterators())
           if (cell->is_ghost())
             {
               for (const unsigned int i : cell->vertex_indices())
                 ghost_layer_vertices.push_back(find(cell->vertex_index(i)));
               ghost_layer_volume.push_back(cell->measure());
-              cell->get_dof_indices(indices);
-              const std::size_t first = ghost_layer_dofs.size();
-              ghost_layer_dofs.resize(first + base.n_dofs_per_cell());
-              for (unsigned int i = 0; i < indices.size(); ++i)
-                {
-                  const auto [component, index] = dof_solid.get_fe().system_to_component_index(i);
-                  if (component == 0)
-                    ghost_layer_dofs[first + index] = indices[i];
-                }
+              ghost_layer_cells.push_back(cell->global_active_cell_index());
             }
-        if (!ghost_layer_volume.empty())
-          {
-            IndexSet relevant;
-            DoFTools::extract_locally_relevant_dofs(dof_solid, relevant);
-            ghost_layer_values.reinit(dof_solid.locally_owned_dofs(), relevant,
-                                      dof_solid.get_communicator());
-            if (thinc_curved)
-              normal_values.reinit(dof_solid.locally_owned_dofs(), relevant,
-                                   dof_solid.get_communicator());
-          }
+        const auto *parallel =
+          dynamic_cast<const parallel::TriangulationBase<dim> *>(&dof_solid.get_triangulation());
+        AssertThrow(parallel != nullptr, ExcMessage("the transport needs a parallel triangulation"));
+        const auto partitioner = parallel->global_active_cell_index_partitioner().lock();
+        for (auto &values : cell_exchange)
+          values.reinit(partitioner);
       }
+  }
+
+  template <int dim>
+  Point<dim, VectorizedArray<double>>
+  TransportOperator<dim>::cell_point(const unsigned int cell, const unsigned int quadrature,
+                                     const unsigned int q) const
+  {
+    const Point<dim>                   &unit = unit_cell_points[quadrature][q];
+    Point<dim, VectorizedArray<double>> x;
+    for (unsigned int v = 0; v < VectorizedArray<double>::size(); ++v)
+      {
+        const unsigned int k = cell * VectorizedArray<double>::size() +
+                               std::min(v, matrix_free.n_active_entries_per_cell_batch(cell) - 1);
+        for (unsigned int d = 0; d < dim; ++d)
+          x[d][v] = cell_corner[k][d] + cell_extent[k][d] * unit[d];
+      }
+    return x;
+  }
+
+  template <int dim>
+  Point<dim, VectorizedArray<double>> TransportOperator<dim>::face_point(const unsigned int face,
+                                                                         const unsigned int q) const
+  {
+    const auto &info = matrix_free.get_face_info(face);
+    const Point<dim>                   &unit = unit_face_points[info.interior_face_no][q];
+    Point<dim, VectorizedArray<double>> x;
+    for (unsigned int v = 0; v < VectorizedArray<double>::size(); ++v)
+      {
+        const unsigned int k =
+          info.cells_interior[std::min(v, matrix_free.n_active_entries_per_face_batch(face) - 1)];
+        for (unsigned int d = 0; d < dim; ++d)
+          x[d][v] = cell_corner[k][d] + cell_extent[k][d] * unit[d];
+      }
+    return x;
+  }
+
+  template <int dim>
+  std::size_t TransportOperator<dim>::memory_consumption() const
+  {
+    using MemoryConsumption::memory_consumption;
+    return matrix_free.memory_consumption() + memory_consumption(cell_size) +
+           memory_consumption(face_size) + memory_consumption(cell_corner) +
+           memory_consumption(cell_extent) + memory_consumption(cell_volume) +
+           memory_consumption(cell_vertices) + memory_consumption(lane_global_cell) +
+           memory_consumption(vertex_mean) +
+           memory_consumption(vertex_weight) + memory_consumption(cell_mean) +
+           reconstruction.size() * sizeof(Lanes) + b_active.memory_consumption() +
+           memory_consumption(lane_cell_index) + memory_consumption(owned_cell_lane) +
+           memory_consumption(periodic_face_lane) + memory_consumption(vertex_normal) +
+           memory_consumption(ghost_layer_vertices) + memory_consumption(ghost_layer_volume) +
+           memory_consumption(ghost_layer_cells) +
+           n_cell_values * cell_exchange[0].memory_consumption();
   }
 
   template <int dim>

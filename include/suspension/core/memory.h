@@ -12,7 +12,8 @@ namespace Suspension
   /// item 4).
   struct MemoryEstimate
   {
-    double cells          = 0.; // of the initial mesh (before adaptation)
+    double cells          = 0.; // of the mesh the estimate is for
+    bool   refined        = false; // an adaptively refined mesh (costs more per cell)
     double bytes_per_cell = 0.; // measured, see memory.cc
     double bytes_per_rank = 0.; // the mesh's share of one rank, plus the base
     double available_per_rank = 0.; // MemAvailable of the node / its ranks
@@ -24,11 +25,22 @@ namespace Suspension
   /// ranks of `communicator`.
   MemoryEstimate estimate_memory(const Parameters::All &parameters, MPI_Comm communicator);
 
+  /// The estimate for a mesh of `cells` active cells, refined towards the
+  /// interfaces when the scene's mesh is adaptive.
+  MemoryEstimate estimate_memory(const Parameters::All &parameters, double cells,
+                                 MPI_Comm communicator);
+
   /// Throws an InputError of 'Mesh/Global refinements' when the estimate
   /// does not fit in the memory available to the ranks of a node: a run
   /// that would be killed by the system after its set-up stops at once,
   /// before anything is written.
   void check_memory(const Parameters::All &parameters, MPI_Comm communicator);
+
+  /// The same for the mesh of the initial refinement towards the
+  /// particles, checked before its fields are built: throws an InputError
+  /// of 'Mesh refinement/Maximum level' (collective).
+  void check_memory_of_refined_mesh(const Parameters::All &parameters, double cells,
+                                    MPI_Comm communicator);
 
   /// Peak resident memory (VmHWM) of this process, in bytes.
   double peak_resident_memory();

@@ -102,7 +102,10 @@ namespace Suspension
     /// match before p4est reads the mesh (dimension, coarse cells, finite
     /// elements), and the rank count it was written on.
     std::string checkpoint_header() const;
-    void   create_initial_mesh();
+    /// The scene's mesh, refined towards the initial interface. Returns
+    /// true if the space and the solid are already set up on it (the last
+    /// cycle flagged nothing), so that setup() does not build them twice.
+    bool   create_initial_mesh();
     bool   adapt_mesh();
     void   change_mesh_with_fields();
     double choose_time_step(double dt, double time, const Fluid::FlowDiagnostics &d) const;
@@ -140,6 +143,8 @@ namespace Suspension
     std::unique_ptr<Postprocess::ChannelStatistics<dim>> channel_statistics;
     TableHandler                              statistics;
     double                                    smallest_cell_size = 0.; // per mesh
+    /// memory per rank estimated for the initial (refined) mesh, bytes
+    double                                    initial_memory_estimate = 0.;
     double                                    last_output_time   = 0.;
     double                                    last_driving_force = 0.;
     unsigned int                              n_outputs          = 0;

@@ -209,6 +209,9 @@ namespace Suspension::Solid
     const DoFHandler<dim> &get_dof_handler() const { return dof_handler; }
     const FiniteElement<dim> &get_fe() const { return fe; }
     const VectorType      &get_solution() const { return solution; }
+    /// Bytes held on this rank, by part: the DoFs, the transport's
+    /// MatrixFree data, its other per-cell data and scratch, the fields.
+    std::vector<std::pair<std::string, std::size_t>> memory_by_part() const;
     std::vector<std::string> component_names() const;
 
   private:

@@ -1,5 +1,6 @@
 #pragma once
 
+#include <deal.II/base/geometry_info.h>
 #include <deal.II/base/quadrature_lib.h>
 #include <deal.II/base/tensor.h>
 #include <deal.II/base/symmetric_tensor.h>
@@ -130,6 +131,12 @@ namespace Suspension::Solid
     /// face part of the total variation of phi, for the interface width.
     double face_jumps(const VectorType &solution, double touches) const;
 
+    /// Bytes held on this rank: the MatrixFree data (mapping, DoF
+    /// indices), the per-cell geometry and profiles, the scratch vectors.
+    std::size_t memory_consumption() const;
+    /// Of these, the MatrixFree data alone.
+    std::size_t matrix_free_memory() const { return matrix_free.memory_consumption(); }
+
     /// Where B is transported: B = I wherever a cell and its face
     /// neighbours hold no solid (every node of phi at most 1e-8), since
     /// reset_B_in_fluid() would put it back to I there anyway. Marks the
@@ -244,10 +251,27 @@ namespace Suspension::Solid
     std::vector<Point<dim>> profile_points;
     std::vector<double>     profile_weights;
     std::vector<unsigned int>           cell_vertices;
-    /// the phi DoFs of the cells and ghost cells by lane: global indices
-    /// and indices local to the MatrixFree's vectors
-    std::vector<types::global_dof_index> lane_phi_dofs;
-    std::vector<unsigned int>            lane_phi_local;
+    /// The quadrature points of a cell batch (quadrature 0 or 1) and of
+    /// the interior side of a face batch (quadrature 0), where the THINC
+    /// profile is evaluated: the box of the cell maps the unit cell's
+    /// points, so that MatrixFree need not store them (in 3D with DG 2,
+    /// 91 points per cell and 25 per face, about 0.4 of its memory).
+    Point<dim, VectorizedArray<double>> cell_point(unsigned int cell, unsigned int quadrature,
+                                                   unsigned int q) const;
+    Point<dim, VectorizedArray<double>> face_point(unsigned int face, unsigned int q) const;
+    /// the unit cell's points of quadratures 0 and 1, and of quadrature 0
+    /// on each face
+    std::array<std::vector<Point<dim>>, 2>                          unit_cell_points;
+    std::array<std::vector<Point<dim>>, GeometryInfo<dim>::faces_per_cell> unit_face_points;
+    /// global_active_cell_index() of the cells and ghost cells by lane
+    std::vector<types::global_cell_index> lane_global_cell;
+    /// What a cell's neighbours on other ranks need of it: its mean, its
+    /// unit normal, its profile (weight, offset, slope, curvature), one
+    /// value per active cell and vector, with the ghost cells of the
+    /// triangulation (a few doubles per cell, where solid vectors with
+    /// all the DoFs of phi and B took 1.5 kB per cell in 3D)
+    static constexpr unsigned int             n_cell_values = 3 + dim;
+    mutable std::array<VectorType, n_cell_values> cell_exchange;
     mutable std::vector<double>         vertex_mean, vertex_weight;
     mutable std::vector<double>         cell_mean;
     mutable AlignedVector<Lanes>        reconstruction;
@@ -261,17 +285,13 @@ namespace Suspension::Solid
     std::vector<unsigned int> owned_cell_lane;
     /// 1 in the lanes of inner face batches that are periodic faces
     std::vector<unsigned char> periodic_face_lane;
-    /// solution with the ghost values of the face neighbours (face_jumps)
-    mutable VectorType face_scratch;
-    mutable VectorType           ghosted, ghosted_curvature;
     /// volume-weighted sums of the cells' unit normals at the vertices,
     /// for div n
     mutable std::vector<Tensor<1, dim>> vertex_normal;
-    mutable VectorType                  normal_values;
-    /// the ghost layer of the mesh: vertices, volumes, phi DoFs by cell
-    std::vector<unsigned int>            ghost_layer_vertices;
-    std::vector<double>                  ghost_layer_volume;
-    std::vector<types::global_dof_index> ghost_layer_dofs;
-    mutable VectorType                   ghost_layer_values;
+    /// the ghost layer of the mesh (all cells that share a vertex with an
+    /// owned one): vertices, volumes, global active cell indices
+    std::vector<unsigned int>             ghost_layer_vertices;
+    std::vector<double>                   ghost_layer_volume;
+    std::vector<types::global_cell_index> ghost_layer_cells;
   };
 } // namespace Suspension::Solid
