@@ -86,9 +86,15 @@ namespace Suspension
   MemoryEstimate estimate_memory(const Parameters::All &p, const double cells,
                                  MPI_Comm communicator)
   {
+    return estimate_memory(p, cells, p.mesh_refinement.enabled, communicator);
+  }
+
+  MemoryEstimate estimate_memory(const Parameters::All &p, const double cells, const bool refined,
+                                 MPI_Comm communicator)
+  {
     MemoryEstimate e;
     e.cells          = cells;
-    e.refined        = p.mesh_refinement.enabled;
+    e.refined        = refined;
     e.bytes_per_cell = bytes_per_cell(p, e.refined);
     const unsigned int ranks = dealii::Utilities::MPI::n_mpi_processes(communicator);
     e.bytes_per_rank = base_bytes + e.cells / ranks * e.bytes_per_cell;
@@ -107,13 +113,8 @@ namespace Suspension
     double cells = std::pow(2., double(p.dimension * p.mesh.global_refinements));
     for (const unsigned int n : p.geometry.subdivisions)
       cells *= n;
-    MemoryEstimate e = estimate_memory(p, cells, communicator);
     // the coarse mesh is uniform: its cost per cell is that of a uniform mesh
-    e.refined        = false;
-    e.bytes_per_cell = bytes_per_cell(p, false);
-    e.bytes_per_rank = base_bytes + e.cells / dealii::Utilities::MPI::n_mpi_processes(communicator) *
-                                      e.bytes_per_cell;
-    return e;
+    return estimate_memory(p, cells, false, communicator);
   }
 
   namespace

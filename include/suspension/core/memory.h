@@ -30,6 +30,11 @@ namespace Suspension
   MemoryEstimate estimate_memory(const Parameters::All &parameters, double cells,
                                  MPI_Comm communicator);
 
+  /// The same with the cost per cell of a uniform (`refined` false) or a
+  /// refined mesh chosen by the caller.
+  MemoryEstimate estimate_memory(const Parameters::All &parameters, double cells, bool refined,
+                                 MPI_Comm communicator);
+
   /// Throws an InputError of 'Mesh/Global refinements' when the estimate
   /// does not fit in the memory available to the ranks of a node: a run
   /// that would be killed by the system after its set-up stops at once,
