@@ -207,19 +207,25 @@ namespace Suspension
       pcout << "  "
             << memory_line(space.dof_velocity.n_dofs(), initial_memory_estimate, communicator)
             << std::endl;
-    if (parameters.output.timer_summary && solid)
+    if (parameters.output.timer_summary)
       {
-        // where the solid's share goes (the largest rank's), the part that
-        // issue 14 cut: MatrixFree without quadrature points, no scratch
-        // vectors of all DoFs for the exchange of the profiles
-        std::ostringstream line;
-        line << "  of which the solid (MB, largest rank):" << std::fixed << std::setprecision(0);
-        for (const auto &[name, bytes] : solid->memory_by_part())
-          line << " " << name.substr(name.find(' ') + 1) << " "
-               << Utilities::MPI::max(double(bytes), communicator) / 1e6 << ",";
-        std::string text = line.str();
-        text.pop_back();
-        pcout << text << std::endl;
+        // where the memory goes (the largest rank's), by part: what issue
+        // 14 cut (the solid's MatrixFree without quadrature points, no
+        // scratch vectors of all DoFs; the fluid's work vectors shared)
+        const auto print_parts = [&](const std::string &what, const auto &parts) {
+          std::ostringstream line;
+          line << "  of which the " << what << " (MB, largest rank):" << std::fixed
+               << std::setprecision(0);
+          for (const auto &[name, bytes] : parts)
+            line << " " << name.substr(name.find(' ') + 1) << " "
+                 << Utilities::MPI::max(double(bytes), communicator) / 1e6 << ",";
+          std::string text = line.str();
+          text.pop_back();
+          pcout << text << std::endl;
+        };
+        print_parts("fluid", fluid.memory_by_part());
+        if (solid)
+          print_parts("solid", solid->memory_by_part());
       }
 
     RunSummary summary;

@@ -7,7 +7,6 @@ namespace Suspension::Fluid
   template <int dim>
   void DivergenceOperator<dim>::reinit(const MomentumOperator<dim> &op)
   {
-    op.get_matrix_free().initialize_dof_vector(velocity, op.velocity_index);
     op.get_matrix_free().initialize_dof_vector(result, op.pressure_index);
   }
 
@@ -15,6 +14,7 @@ namespace Suspension::Fluid
   void DivergenceOperator<dim>::apply(const MomentumOperator<dim> &op, const VectorType &u,
                                       VectorType &load)
   {
+    auto &velocity = op.work_vector(0);
     copy_locally_owned(u, velocity);
     velocity.update_ghost_values();
     if (op.velocity_degree() == 2)
@@ -49,7 +49,7 @@ namespace Suspension::Fluid
             q.integrate_scatter(EvaluationFlags::values, dst);
           }
       },
-      result, velocity, true);
+      result, op.work_vector(0), true);
   }
 
   template class DivergenceOperator<2>;

@@ -31,6 +31,29 @@ namespace Suspension::Fluid
     AssertThrow(VecRestoreArray(to, &values) == 0, ExcMessage("VecRestoreArray"));
   }
 
+  void form_locally_owned(const Combination &terms, VectorType &to)
+  {
+    Assert(!terms.empty(), ExcInternalError());
+    AssertThrow(VecCopy(*terms[0].second, to) == 0, ExcMessage("VecCopy"));
+    AssertThrow(VecScale(to, terms[0].first) == 0, ExcMessage("VecScale"));
+    for (unsigned int k = 1; k < terms.size(); ++k)
+      AssertThrow(VecAXPY(to, terms[k].first, *terms[k].second) == 0, ExcMessage("VecAXPY"));
+  }
+
+  void form_locally_owned(const Combination &terms, LinearAlgebra::distributed::Vector<double> &to)
+  {
+    Assert(!terms.empty(), ExcInternalError());
+    Vec view;
+    AssertThrow(VecCreateMPIWithArray(to.get_mpi_communicator(), 1, to.locally_owned_size(),
+                                      PETSC_DETERMINE, to.begin(), &view) == 0,
+                ExcMessage("VecCreateMPIWithArray"));
+    AssertThrow(VecCopy(*terms[0].second, view) == 0, ExcMessage("VecCopy"));
+    AssertThrow(VecScale(view, terms[0].first) == 0, ExcMessage("VecScale"));
+    for (unsigned int k = 1; k < terms.size(); ++k)
+      AssertThrow(VecAXPY(view, terms[k].first, *terms[k].second) == 0, ExcMessage("VecAXPY"));
+    AssertThrow(VecDestroy(&view) == 0, ExcMessage("VecDestroy"));
+  }
+
   template <int dim>
   void MomentumOperator<dim>::reinit(const FluidSpace<dim> &space)
   {
@@ -64,6 +87,8 @@ namespace Suspension::Fluid
         compute_diagonal<-1, 0>(mass_diagonal, 1., 0.);
         compute_diagonal<-1, 0>(viscous_diagonal, 0., 1.);
       }
+    for (const unsigned int i : constrained)
+      mass_diagonal.local_element(i) = viscous_diagonal.local_element(i) = 0.;
   }
 
   template <int dim>
@@ -135,18 +160,28 @@ namespace Suspension::Fluid
   template <int dim>
   void MomentumOperator<dim>::set_coefficients(const double mass_, const double viscosity_)
   {
-    if (mass_ == mass && viscosity_ == viscosity)
-      return;
     mass      = mass_;
     viscosity = viscosity_;
-    Vector &diagonal = inverse_diagonal.get_vector();
-    diagonal.reinit(mass_diagonal, true);
-    diagonal.equ(mass, mass_diagonal);
-    diagonal.add(viscosity, viscous_diagonal);
-    for (const unsigned int i : constrained)
-      diagonal.local_element(i) = 1.;
-    for (auto &d : diagonal)
-      d = d > 0. ? 1. / d : 1.;
+  }
+
+  template <int dim>
+  void MomentumOperator<dim>::InverseDiagonal::vmult(Vector &dst, const Vector &src) const
+  {
+    const double *m = op->mass_diagonal.begin(), *k = op->viscous_diagonal.begin();
+    const double *in  = src.begin();
+    double       *out = dst.begin();
+    for (unsigned int i = 0; i < src.locally_owned_size(); ++i)
+      {
+        const double d = op->mass * m[i] + op->viscosity * k[i];
+        out[i]         = (d > 0. ? 1. / d : 1.) * in[i];
+      }
+  }
+
+  template <int dim>
+  std::size_t MomentumOperator<dim>::vector_memory() const
+  {
+    return mass_diagonal.memory_consumption() + viscous_diagonal.memory_consumption() +
+           x_local.memory_consumption() + b_local.memory_consumption();
   }
 
   template <int dim>
@@ -166,7 +201,7 @@ namespace Suspension::Fluid
       {
         SolverControl    control(5000, tolerance * norm);
         SolverCG<Vector> cg(control);
-        cg.solve(*this, x_local, b_local, inverse_diagonal);
+        cg.solve(*this, x_local, b_local, InverseDiagonal{this});
         iterations = control.last_step();
       }
     copy_locally_owned(x_local, x);

@@ -8,10 +8,9 @@ namespace Suspension::Fluid
   template <int dim>
   void MomentumRightHandSide<dim>::reinit(const MomentumOperator<dim> &op)
   {
-    const auto &mf = op.get_matrix_free();
-    for (auto *v : {&history, &u_star, &lifting, &result})
-      mf.initialize_dof_vector(*v, op.velocity_index);
-    mf.initialize_dof_vector(p_sharp, op.pressure_index);
+    u_star.reinit(0);
+    lifting.reinit(0);
+    op.get_matrix_free().initialize_dof_vector(p_sharp, op.pressure_index);
   }
 
   template <int dim>
@@ -21,34 +20,43 @@ namespace Suspension::Fluid
                                             const MomentumLoad<dim>         &load,
                                             VectorType                      &rhs)
   {
-    const auto read = [](const VectorType &from, Vector &to) {
-      copy_locally_owned(from, to);
+    const auto &mf      = op.get_matrix_free();
+    Vector     &history = op.work_vector(0);
+    const auto  read    = [](const Combination &terms, Vector &to) {
+      form_locally_owned(terms, to);
       to.update_ghost_values();
     };
-    read(*load.history, history);
-    read(*load.p_sharp, p_sharp);
+    read(load.history, history);
+    read(load.p_sharp, p_sharp);
     if (load.convection)
-      read(*load.u_star, u_star);
+      {
+        if (u_star.size() == 0)
+          mf.initialize_dof_vector(u_star, op.velocity_index);
+        read(load.u_star, u_star);
+      }
 
     // the lifting g: the boundary data of the step at the constrained DoFs
     // (hanging nodes next to a moving wall inherit theirs), zero elsewhere
-    lifting = 0.;
     bool lifted = false;
     for (const auto &line : step_constraints.get_lines())
-      if (line.inhomogeneity != 0. && lifting.in_local_range(line.index))
-        {
-          lifting(line.index) = line.inhomogeneity;
-          lifted              = true;
-        }
+      lifted = lifted || (line.inhomogeneity != 0. && history.in_local_range(line.index));
     lifted = Utilities::MPI::max(lifted ? 1 : 0, space.communicator()) > 0;
     if (lifted)
-      lifting.update_ghost_values();
+      {
+        if (lifting.size() == 0)
+          mf.initialize_dof_vector(lifting, op.velocity_index);
+        lifting = 0.;
+        for (const auto &line : step_constraints.get_lines())
+          if (line.inhomogeneity != 0. && lifting.in_local_range(line.index))
+            lifting(line.index) = line.inhomogeneity;
+        lifting.update_ghost_values();
+      }
 
     if (op.velocity_degree() == 2)
       cell_loop<2, 3>(op, space, load, lifted);
     else
       cell_loop<-1, 0>(op, space, load, lifted);
-    copy_locally_owned(result, rhs);
+    copy_locally_owned(op.work_vector(1), rhs);
     for (auto *v : {&history, &u_star, &lifting, &p_sharp})
       v->zero_out_ghost_values();
   }
@@ -63,6 +71,7 @@ namespace Suspension::Fluid
     using VA = VectorizedArray<double>;
     constexpr int pressure_degree = degree < 0 ? -1 : degree - 1;
     const auto   &mf = op.get_matrix_free();
+    const Vector &history = op.work_vector(0);
     const auto   &unit_points = space.quadrature.get_points();
     const double  inv_rho = load.inverse_density;
 
@@ -160,7 +169,7 @@ namespace Suspension::Fluid
                                  dst);
         }
     };
-    mf.template cell_loop<Vector, Vector>(worker, result, history, true);
+    mf.template cell_loop<Vector, Vector>(worker, op.work_vector(1), history, true);
   }
 
   template class MomentumRightHandSide<2>;

@@ -5,6 +5,11 @@
 
 #include <suspension/fluid/projection_scheme.h>
 
+#include <petscvec.h>
+
+#include <algorithm>
+#include <cmath>
+
 #include <iomanip>
 #include <istream>
 #include <ostream>
@@ -31,10 +36,16 @@ namespace Suspension::Fluid
       v->reinit(space.owned_velocity, comm);
     for (auto *v : {&p, &psi, &psi_old, &div_u, &div_u_load, &rhs_p})
       v->reinit(space.owned_pressure, comm);
-    for (auto *v : {&velocity_ghosted, &u_star_ghosted, &u_history_ghosted})
-      v->reinit(space.owned_velocity, space.relevant_velocity, comm);
-    for (auto *v : {&pressure_ghosted, &p_sharp_ghosted})
-      v->reinit(space.owned_pressure, space.relevant_pressure, comm);
+    velocity_ghosted.reinit(space.owned_velocity, space.relevant_velocity, comm);
+    pressure_ghosted.reinit(space.owned_pressure, space.relevant_pressure, comm);
+    // the assembled right-hand side reads ghosted copies of its fields; the
+    // matrix-free one forms them in its own vectors
+    if (!operators.matrix_free_momentum || operators.step_matrix)
+      {
+        for (auto *v : {&u_star_ghosted, &u_history_ghosted})
+          v->reinit(space.owned_velocity, space.relevant_velocity, comm);
+        p_sharp_ghosted.reinit(space.owned_pressure, space.relevant_pressure, comm);
+      }
     matrix_free_rhs_ready = false;
   }
 
@@ -280,23 +291,12 @@ namespace Suspension::Fluid
     section.next("fluid: momentum right-hand side");
     u_older = u_old;
     u_old   = u;
-    {
-      VectorType tmp(u_old);
-      tmp *= 1. + extrapolation;
-      tmp.add(-extrapolation, u_older);
-      u_star_ghosted = tmp;
-      tmp = u_old;
-      tmp *= beta_1 / dt;
-      tmp.add(-beta_2 / dt, u_older);
-      u_history_ghosted = tmp;
-      VectorType ps(p);
-      if (n_steps > 0)
-        {
-          ps.add(4. / 3., psi);
-          ps.add(-1. / 3., psi_old);
-        }
-      p_sharp_ghosted = ps;
-    }
+    MomentumLoad<dim> load;
+    load.u_star  = {{1. + extrapolation, &u_old}, {-extrapolation, &u_older}};
+    load.history = {{beta_1 / dt, &u_old}, {-beta_2 / dt, &u_older}};
+    load.p_sharp = {{1., &p}};
+    if (n_steps > 0)
+      load.p_sharp.insert(load.p_sharp.end(), {{4. / 3., &psi}, {-1. / 3., &psi_old}});
 
     // 1. momentum predictor
     // Boundary data only need rebuilding when a face carries a (possibly
@@ -306,7 +306,7 @@ namespace Suspension::Fluid
     if (scene.has_inhomogeneous_velocity() || n_steps == 0)
       space.make_velocity_constraints(scene, !scene.has_inhomogeneous_velocity(),
                                       step_constraints);
-    assemble_momentum_rhs(dt, t_new, sources);
+    assemble_momentum_rhs(load, dt, t_new, sources);
     const double tolerance = parameters.fluid_solver.solver_tolerance;
     if (operators.step_matrix)
       {
@@ -364,10 +364,8 @@ namespace Suspension::Fluid
       p.add(-nu, div_u);
 
     {
-      VectorType change(u);
-      change.add(-1., u_old);
       const double umax = u.linfty_norm();
-      last_change_rate  = umax > 0 ? change.linfty_norm() / (dt * umax) : 0.;
+      last_change_rate  = umax > 0 ? max_difference(u, u_old) / (dt * umax) : 0.;
     }
 
     velocity_ghosted = u;
@@ -392,6 +390,50 @@ namespace Suspension::Fluid
   }
 
   template <int dim>
+  std::vector<std::pair<std::string, std::size_t>> ProjectionScheme<dim>::memory_by_part() const
+  {
+    std::size_t dofs = space.dof_velocity.memory_consumption() +
+                       space.dof_pressure.memory_consumption() +
+                       step_constraints.memory_consumption();
+    for (const auto *c : {&space.velocity_constraints, &space.velocity_continuity,
+                          &space.pressure_constraints, &space.increment_constraints})
+      dofs += c->memory_consumption();
+    std::size_t matrices = 0;
+    for (const auto *m : {&operators.M, &operators.K, &operators.A, &operators.L,
+                          &operators.Mp, &operators.D, &operators.A_step})
+      matrices += m->memory_consumption();
+    std::size_t vectors = operators.momentum_operator.vector_memory() +
+                          matrix_free_rhs.memory_consumption() +
+                          operators.divergence_operator.memory_consumption();
+    for (const VectorType *v : std::initializer_list<const VectorType *>{
+           &u, &u_old, &u_older, &unit_response, &p, &psi, &psi_old, &div_u,
+                          &div_u_load, &rhs_u, &rhs_p, &velocity_ghosted, &pressure_ghosted,
+                          &u_star_ghosted, &u_history_ghosted, &p_sharp_ghosted,
+                          &operators.flux_weights, &operators.unit_force})
+      vectors += v->size() > 0 ? v->memory_consumption() : 0;
+    return {{"fluid DoFs", dofs},
+            {"fluid MatrixFree", operators.momentum_operator.matrix_free_memory()},
+            {"fluid matrices", matrices},
+            {"fluid vectors", vectors}};
+  }
+
+  template <int dim>
+  double ProjectionScheme<dim>::max_difference(const VectorType &a, const VectorType &b) const
+  {
+    const PetscScalar *x, *y;
+    PetscInt           n;
+    AssertThrow(VecGetLocalSize(a, &n) == 0, ExcMessage("VecGetLocalSize"));
+    AssertThrow(VecGetArrayRead(a, &x) == 0 && VecGetArrayRead(b, &y) == 0,
+                ExcMessage("VecGetArrayRead"));
+    double difference = 0.;
+    for (PetscInt i = 0; i < n; ++i)
+      difference = std::max(difference, std::abs(x[i] - y[i]));
+    AssertThrow(VecRestoreArrayRead(a, &x) == 0 && VecRestoreArrayRead(b, &y) == 0,
+                ExcMessage("VecRestoreArrayRead"));
+    return Utilities::MPI::max(difference, space.communicator());
+  }
+
+  template <int dim>
   VectorType ProjectionScheme<dim>::extrapolated_velocity(const double dt) const
   {
     VectorType v(u);
@@ -406,7 +448,7 @@ namespace Suspension::Fluid
 
   template <int dim>
   void ProjectionScheme<dim>::assemble_momentum_rhs(
-    const double dt, const double t_new,
+    MomentumLoad<dim> &load, const double dt, const double t_new,
     const std::vector<const MomentumSource<dim> *> &sources)
   {
     const bool convection =
@@ -420,10 +462,6 @@ namespace Suspension::Fluid
         if (!matrix_free_rhs_ready)
           matrix_free_rhs.reinit(operators.momentum_operator);
         matrix_free_rhs_ready = true;
-        MomentumLoad<dim> load;
-        load.history         = &u_history_ghosted;
-        load.u_star          = &u_star_ghosted;
-        load.p_sharp         = &p_sharp_ghosted;
         load.sources         = &sources;
         load.time            = t_new;
         load.alpha_over_dt   = operators.momentum_alpha_over_dt;
@@ -433,6 +471,16 @@ namespace Suspension::Fluid
         load.stress          = any_stress;
         matrix_free_rhs.assemble(operators.momentum_operator, space, step_constraints, load, rhs_u);
         return;
+      }
+
+    // ghosted copies of the fields for the cells' FEValues
+    for (const auto &[terms, ghosted] :
+         {std::pair(&load.u_star, &u_star_ghosted), std::pair(&load.history, &u_history_ghosted),
+          std::pair(&load.p_sharp, &p_sharp_ghosted)})
+      {
+        VectorType owned(ghosted->locally_owned_elements(), space.communicator());
+        form_locally_owned(*terms, owned);
+        *ghosted = owned;
       }
 
     rhs_u = 0.;

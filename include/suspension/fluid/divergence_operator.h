@@ -24,13 +24,16 @@ namespace Suspension::Fluid
     /// After every mesh change (the momentum operator reinitialized).
     void reinit(const MomentumOperator<dim> &op);
 
-    /// load = D u (u: locally owned entries suffice; load: owned).
+    /// load = D u (u: locally owned entries suffice; load: owned). u is
+    /// read through the momentum operator's work vector 0 (not in a solve).
     void apply(const MomentumOperator<dim> &op, const VectorType &u, VectorType &load);
+
+    std::size_t memory_consumption() const { return result.memory_consumption(); }
 
   private:
     template <int degree, int n_q>
     void cell_loop(const MomentumOperator<dim> &op);
 
-    LinearAlgebra::distributed::Vector<double> velocity, result;
+    LinearAlgebra::distributed::Vector<double> result; // u: the operator's work vector 0
   };
 } // namespace Suspension::Fluid

@@ -1,12 +1,14 @@
 #pragma once
 
-#include <deal.II/lac/diagonal_matrix.h>
 #include <deal.II/lac/la_parallel_vector.h>
 #include <deal.II/matrix_free/matrix_free.h>
 
 #include <deal.II/lac/generic_linear_algebra.h>
 
 #include <suspension/fluid/fluid_space.h>
+
+#include <utility>
+#include <vector>
 
 namespace Suspension::Fluid
 {
@@ -16,8 +18,9 @@ namespace Suspension::Fluid
    * FEEvaluation (sum factorisation), the hanging-node, periodic and
    * Dirichlet constraints of the velocity resolved on the fly; CG with the
    * Jacobi preconditioner of its diagonal, computed matrix-free: the
-   * diagonals of M and of K once per mesh, so that a change of dt costs
-   * one vector update (with the adaptive time step dt changes every step);
+   * diagonals of M and of K once per mesh, combined on the fly in every
+   * application of the preconditioner, so that a change of dt costs
+   * nothing (with the adaptive time step dt changes every step);
    * a mesh change only the MatrixFree data and those two diagonals. The
    * vectors of the rest of the fluid stay PETSc's: a solve copies the
    * right-hand side in and the solution out (locally owned entries; the
@@ -31,6 +34,17 @@ namespace Suspension::Fluid
   void copy_locally_owned(const VectorType &from, LinearAlgebra::distributed::Vector<double> &to);
   void copy_locally_owned(const LinearAlgebra::distributed::Vector<double> &from, VectorType &to);
 
+  /// c_0 v_0 + c_1 v_1 + ...: a field formed from the time levels where it
+  /// is needed instead of being stored (issue 14, item 4).
+  using Combination = std::vector<std::pair<double, const VectorType *>>;
+
+  /// The locally owned entries of `terms` into `to`, computed by PETSc on
+  /// a view of `to`'s memory (VecCopy, VecScale, VecAXPY: the same
+  /// arithmetic as the stored PETSc copies this replaces).
+  void form_locally_owned(const Combination &terms, LinearAlgebra::distributed::Vector<double> &to);
+  /// the same into a PETSc vector with `to`'s layout
+  void form_locally_owned(const Combination &terms, VectorType &to);
+
   template <int dim>
   class MomentumOperator
   {
@@ -40,8 +54,8 @@ namespace Suspension::Fluid
     /// After every mesh change (the space rebuilt).
     void reinit(const FluidSpace<dim> &space);
 
-    /// The coefficients (alpha/dt, nu); recomputes the diagonal when they
-    /// change.
+    /// The coefficients (alpha/dt, nu); the Jacobi preconditioner follows
+    /// them without any set-up.
     void set_coefficients(double mass, double viscosity);
 
     /// dst = A src on the unconstrained DoFs; constrained ones copied.
@@ -52,6 +66,15 @@ namespace Suspension::Fluid
     /// distributes the constraints afterwards, as for the assembled A).
     /// Returns the CG iterations.
     unsigned int solve(VectorType &x, const VectorType &b, double tolerance) const;
+
+    /// The two work vectors of a solve (velocity DoFs), free between
+    /// solves: the right-hand side and the divergence borrow them instead
+    /// of holding velocity vectors of their own (issue 14, item 4).
+    Vector &work_vector(const unsigned int i) const { return i == 0 ? x_local : b_local; }
+
+    /// Bytes of the MatrixFree data and of the vectors held here.
+    std::size_t matrix_free_memory() const { return matrix_free.memory_consumption(); }
+    std::size_t vector_memory() const;
 
     /// The cell data, shared with the matrix-free right-hand side: the
     /// velocity DoFs (homogeneous constraints) and the pressure DoFs, one
@@ -67,10 +90,18 @@ namespace Suspension::Fluid
     template <int degree, int n_q>
     void compute_diagonal(Vector &diagonal, double mass, double viscosity) const;
 
+    /// Jacobi: dst = src / (mass diag M + viscosity diag K), formed on the
+    /// fly from the two diagonals (zero at constrained DoFs, which are left
+    /// as they are) instead of a third stored vector.
+    struct InverseDiagonal
+    {
+      const MomentumOperator *op;
+      void vmult(Vector &dst, const Vector &src) const;
+    };
+
     MatrixFree<dim, double> matrix_free;
     unsigned int            degree = 2;
     double                  mass = -1., viscosity = -1.;
-    DiagonalMatrix<Vector>  inverse_diagonal;
     Vector                  mass_diagonal, viscous_diagonal; // of M and K
     std::vector<unsigned int> constrained; // local indices, all constrained DoFs
     mutable Vector          x_local, b_local;

@@ -16,9 +16,9 @@ namespace Suspension::Fluid
   template <int dim>
   struct MomentumLoad
   {
-    const VectorType *history = nullptr; // (beta_1 u^n - beta_2 u^{n-1}) / dt
-    const VectorType *u_star  = nullptr; // extrapolated velocity (convection)
-    const VectorType *p_sharp = nullptr; // P# (pressure dofs)
+    Combination history; // (beta_1 u^n - beta_2 u^{n-1}) / dt
+    Combination u_star;  // extrapolated velocity (convection)
+    Combination p_sharp; // P# (pressure dofs)
     const std::vector<const MomentumSource<dim> *> *sources = nullptr;
     double time          = 0.;  // t^{n+1}, at which the sources are evaluated
     double alpha_over_dt = 0.;  // of (alpha/dt) M + nu K, for the lifting
@@ -48,6 +48,11 @@ namespace Suspension::Fluid
    * FEEvaluation's sum factorisation replaces FEValues' shape-function
    * tables; the sources keep their interface (they are called per cell
    * with the real and unit quadrature points).
+   *
+   * Memory: the history and the result live in the momentum operator's
+   * two work vectors (free outside its solves); the extrapolated velocity
+   * is held only with convection and the lifting only while some face
+   * moves, so a channel holds one velocity vector here, not five.
    */
   template <int dim>
   class MomentumRightHandSide
@@ -64,12 +69,18 @@ namespace Suspension::Fluid
                   const MomentumLoad<dim>         &load,
                   VectorType                      &rhs);
 
+    std::size_t memory_consumption() const
+    {
+      return u_star.memory_consumption() + lifting.memory_consumption() +
+             p_sharp.memory_consumption();
+    }
+
   private:
     template <int degree, int n_q>
     void cell_loop(const MomentumOperator<dim> &op, const FluidSpace<dim> &space,
                    const MomentumLoad<dim> &load, bool lifted);
 
     using Vector = LinearAlgebra::distributed::Vector<double>;
-    Vector history, u_star, lifting, p_sharp, result;
+    Vector u_star, lifting, p_sharp; // u_star, lifting: allocated on first use
   };
 } // namespace Suspension::Fluid

@@ -13,6 +13,8 @@
 #include <iosfwd>
 #include <memory>
 #include <optional>
+#include <string>
+#include <utility>
 #include <vector>
 
 namespace Suspension::Fluid
@@ -115,13 +117,23 @@ namespace Suspension::Fluid
     double time() const { return current_time; }
     unsigned int step_number() const { return n_steps; }
 
+    /// Bytes per part of the fluid on this rank (the run summary's
+    /// memory line): DoFs and constraints, MatrixFree, the assembled
+    /// matrices (PETSc's count, without BoomerAMG's hierarchy), vectors.
+    std::vector<std::pair<std::string, std::size_t>> memory_by_part() const;
+
     const VectorType &velocity() const { return velocity_ghosted; }
     /// Kinematic pressure P = p / rho (ghosted).
     const VectorType &kinematic_pressure() const { return pressure_ghosted; }
 
   private:
-    void       assemble_momentum_rhs(double dt, double t_new,
+    /// rhs_u from `load`'s fields (the coefficients and sources are
+    /// filled in here)
+    void       assemble_momentum_rhs(MomentumLoad<dim> &load, double dt, double t_new,
                                      const std::vector<const MomentumSource<dim> *> &sources);
+    /// max_i |a_i - b_i| over the locally owned entries of all ranks,
+    /// without a temporary vector
+    double     max_difference(const VectorType &a, const VectorType &b) const;
     void       allocate_vectors();
     /// Ghosted copies of the transferred time levels, handed to new
     /// SolutionTransfer objects.
@@ -152,7 +164,7 @@ namespace Suspension::Fluid
     VectorType p, psi, psi_old, div_u, div_u_load;
     VectorType rhs_u, rhs_p;
     VectorType velocity_ghosted, pressure_ghosted;
-    VectorType u_star_ghosted, u_history_ghosted, p_sharp_ghosted;
+    VectorType u_star_ghosted, u_history_ghosted, p_sharp_ghosted; // assembled rhs only
 
     double       current_time = 0., last_dt = 0.;
     unsigned int n_steps      = 0;
