@@ -44,7 +44,7 @@ namespace Suspension
             parameters.fluid_solver.pressure_degree)
     , fluid(parameters, scene, space, operators)
     , verification_report(parameters, space)
-    , field_output(parameters.output.directory)
+    , field_output(parameters.output.directory, parameters.output.patch_subdivisions)
     , checkpoint(parameters, communicator)
   {
     fluid.set_timer(timer);

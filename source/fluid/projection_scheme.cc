@@ -5,6 +5,7 @@
 
 #include <suspension/fluid/projection_scheme.h>
 
+#include <petscmat.h>
 #include <petscvec.h>
 
 #include <algorithm>
@@ -392,16 +393,23 @@ namespace Suspension::Fluid
   template <int dim>
   std::vector<std::pair<std::string, std::size_t>> ProjectionScheme<dim>::memory_by_part() const
   {
-    std::size_t dofs = space.dof_velocity.memory_consumption() +
-                       space.dof_pressure.memory_consumption() +
-                       step_constraints.memory_consumption();
+    const std::size_t dofs =
+      space.dof_velocity.memory_consumption() + space.dof_pressure.memory_consumption();
+    std::size_t constraints = step_constraints.memory_consumption();
     for (const auto *c : {&space.velocity_constraints, &space.velocity_continuity,
                           &space.pressure_constraints, &space.increment_constraints})
-      dofs += c->memory_consumption();
+      constraints += c->memory_consumption();
+    // PETSc counts its matrices' memory only when asked to trace its
+    // allocations: the stored entries and column indices instead
     std::size_t matrices = 0;
     for (const auto *m : {&operators.M, &operators.K, &operators.A, &operators.L,
                           &operators.Mp, &operators.D, &operators.A_step})
-      matrices += m->memory_consumption();
+      {
+        MatInfo info;
+        AssertThrow(MatGetInfo(*m, MAT_LOCAL, &info) == 0, ExcMessage("MatGetInfo"));
+        matrices += std::size_t(info.nz_allocated) * (sizeof(PetscScalar) + sizeof(PetscInt)) +
+                    std::size_t(m->local_size()) * sizeof(PetscInt);
+      }
     std::size_t vectors = operators.momentum_operator.vector_memory() +
                           matrix_free_rhs.memory_consumption() +
                           operators.divergence_operator.memory_consumption();
@@ -412,6 +420,7 @@ namespace Suspension::Fluid
                           &operators.flux_weights, &operators.unit_force})
       vectors += v->size() > 0 ? v->memory_consumption() : 0;
     return {{"fluid DoFs", dofs},
+            {"fluid constraints", constraints},
             {"fluid MatrixFree", operators.momentum_operator.matrix_free_memory()},
             {"fluid matrices", matrices},
             {"fluid vectors", vectors}};

@@ -74,8 +74,9 @@ namespace Suspension::Postprocess
   } // namespace
 
   template <int dim>
-  FieldOutput<dim>::FieldOutput(const std::string &directory)
+  FieldOutput<dim>::FieldOutput(const std::string &directory, const unsigned int subdivisions)
     : directory(directory)
+    , subdivisions(subdivisions)
   {}
 
   template <int dim>
@@ -117,7 +118,7 @@ namespace Suspension::Postprocess
         }
     data_out.add_data_vector(rank, "rank");
     data_out.add_data_vector(level, "level");
-    data_out.build_patches(space.fe_velocity.degree);
+    data_out.build_patches(subdivisions > 0 ? subdivisions : space.fe_velocity.degree);
 
     const std::string name = data_out.write_vtu_with_pvtu_record(
       directory + "/", "solution", counter++, tria.get_communicator(), 5, 8);

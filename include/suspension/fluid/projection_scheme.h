@@ -118,8 +118,9 @@ namespace Suspension::Fluid
     unsigned int step_number() const { return n_steps; }
 
     /// Bytes per part of the fluid on this rank (the run summary's
-    /// memory line): DoFs and constraints, MatrixFree, the assembled
-    /// matrices (PETSc's count, without BoomerAMG's hierarchy), vectors.
+    /// memory line): DoFHandlers, constraints, MatrixFree, the assembled
+    /// matrices (entries and column indices, without BoomerAMG's
+    /// hierarchy), vectors.
     std::vector<std::pair<std::string, std::size_t>> memory_by_part() const;
 
     const VectorType &velocity() const { return velocity_ghosted; }

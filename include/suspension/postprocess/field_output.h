@@ -32,7 +32,8 @@ namespace Suspension::Postprocess
   class FieldOutput
   {
   public:
-    explicit FieldOutput(const std::string &directory);
+    /// `subdivisions`: of each cell's patch (0: the velocity degree)
+    FieldOutput(const std::string &directory, unsigned int subdivisions = 0);
 
     void write(const Fluid::FluidSpace<dim> &space,
                const Fluid::VectorType      &velocity,
@@ -47,6 +48,7 @@ namespace Suspension::Postprocess
 
   private:
     std::string                                  directory;
+    unsigned int                                 subdivisions = 0;
     unsigned int                                 counter = 0;
     std::vector<std::pair<double, std::string>> records;
   };

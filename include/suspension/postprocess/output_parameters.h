@@ -18,6 +18,7 @@ namespace Suspension::Parameters
     std::string                     directory = "output";
     bool                            write_vtu = true;
     bool                            write_phi_cells = false;
+    unsigned int                    patch_subdivisions = 0; // 0: the velocity degree
     unsigned int                    interval_steps = 0;
     double                          interval_time  = 0.;
     std::vector<std::vector<double>> probe_points;
