@@ -26,6 +26,18 @@ namespace Suspension::Fluid
   }
 
   template <int dim>
+  void FluidSpace<dim>::make_continuity_constraints(const Scene<dim>          &scene,
+                                                    AffineConstraints<double> &constraints) const
+  {
+    constraints.clear();
+    constraints.reinit(relevant_velocity);
+    DoFTools::make_hanging_node_constraints(dof_velocity, constraints);
+    for (const unsigned int d : scene.periodic_directions())
+      DoFTools::make_periodicity_constraints(dof_velocity, 2 * d, 2 * d + 1, d, constraints);
+    constraints.close();
+  }
+
+  template <int dim>
   void FluidSpace<dim>::make_velocity_constraints(
     const Scene<dim>          &scene,
     const bool                 homogeneous,
@@ -64,13 +76,6 @@ namespace Suspension::Fluid
     DoFTools::extract_locally_relevant_dofs(dof_pressure, relevant_pressure);
 
     make_velocity_constraints(scene, true, velocity_constraints);
-
-    velocity_continuity.clear();
-    velocity_continuity.reinit(relevant_velocity);
-    DoFTools::make_hanging_node_constraints(dof_velocity, velocity_continuity);
-    for (const unsigned int d : scene.periodic_directions())
-      DoFTools::make_periodicity_constraints(dof_velocity, 2 * d, 2 * d + 1, d, velocity_continuity);
-    velocity_continuity.close();
 
     pressure_constraints.clear();
     pressure_constraints.reinit(relevant_pressure);

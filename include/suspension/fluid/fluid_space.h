@@ -42,6 +42,11 @@ namespace Suspension::Fluid
                                    bool                       homogeneous,
                                    AffineConstraints<double> &constraints) const;
 
+    /// Hanging nodes and periodicity only (for fields transferred to a
+    /// new mesh, whose boundary values stay as they are).
+    void make_continuity_constraints(const Scene<dim>          &scene,
+                                     AffineConstraints<double> &constraints) const;
+
     MPI_Comm communicator() const;
 
     const parallel::distributed::Triangulation<dim> &triangulation;
@@ -55,7 +60,6 @@ namespace Suspension::Fluid
     IndexSet owned_pressure, relevant_pressure;
 
     AffineConstraints<double> velocity_constraints;  // homogeneous
-    AffineConstraints<double> velocity_continuity;   // hanging + periodic only
     AffineConstraints<double> pressure_constraints;  // hanging + periodic
     AffineConstraints<double> increment_constraints; // ... + one pinned DoF
 

@@ -151,7 +151,10 @@ namespace Suspension::Fluid
     const double           nu;
     TimerOutput           *timer = nullptr;
 
-    AffineConstraints<double> step_constraints; // with boundary data at t^{n+1}
+    /// with boundary data at t^{n+1}; empty unless a face moves
+    AffineConstraints<double> step_constraints;
+    void                             make_step_constraints();
+    const AffineConstraints<double> &constraints_of_step() const;
 
     /// The right-hand side in a matrix-free loop (with the matrix-free
     /// momentum operator, without the semi-implicit step matrix, whose
