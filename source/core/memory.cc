@@ -8,6 +8,9 @@
 #include <fstream>
 #include <iomanip>
 #include <sstream>
+#ifdef __GLIBC__
+#  include <malloc.h>
+#endif
 
 namespace Suspension
 {
@@ -153,6 +156,13 @@ namespace Suspension
                                  "the initial refinement towards the particles to level " +
                                    std::to_string(p.mesh_refinement.maximum_level) + " would " +
                                    does_not_fit(e, communicator));
+  }
+
+  void release_free_memory()
+  {
+#ifdef __GLIBC__
+    malloc_trim(0);
+#endif
   }
 
   double peak_resident_memory()

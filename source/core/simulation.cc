@@ -91,6 +91,7 @@ namespace Suspension
     if (solid && !fields_on_mesh)
       solid->setup(space, adaptor.finest_cell_size());
     smallest_cell_size = smallest_cell();
+    release_free_memory(); // what the initial refinement cycles left behind
     initial_memory_estimate =
       estimate_memory(parameters, triangulation.n_global_active_cells(), communicator).bytes_per_rank;
   }
@@ -161,6 +162,7 @@ namespace Suspension
         solid->finish_mesh_change(space);
       }
     smallest_cell_size = smallest_cell();
+    release_free_memory(); // the old mesh's fields and the transfer's buffers
   }
 
   template <int dim>
