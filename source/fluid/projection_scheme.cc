@@ -681,18 +681,27 @@ namespace Suspension::Fluid
   FlowDiagnostics ProjectionScheme<dim>::compute_diagnostics() const
   {
     FlowDiagnostics d;
-    const FEValuesExtractors::Vector velocities(0);
-    FEValues<dim> fe_u(space.fe_velocity, space.quadrature, update_values | update_JxW_values);
+    // the scalar element's FEValues and the components summed here: the
+    // system's FEValues would copy all its shape values on every cell
+    const auto   &fe     = space.fe_velocity;
+    FEValues<dim> fe_u(fe.base_element(0), space.quadrature, update_values | update_JxW_values);
     std::vector<Tensor<1, dim>> values(space.quadrature.size());
-    Vector<double>              local(space.fe_velocity.n_dofs_per_cell());
-    const double degree = space.fe_velocity.degree;
+    Vector<double>              local(fe.n_dofs_per_cell());
+    const double degree = fe.degree;
     double energy = 0., speed_over_h = 0., speed = 0.;
     for (const auto &cell : space.dof_velocity.active_cell_iterators())
       if (cell->is_locally_owned())
         {
-          fe_u.reinit(cell);
+          fe_u.reinit(typename Triangulation<dim>::cell_iterator(cell));
           cell->get_dof_values(velocity_ghosted, local);
-          fe_u[velocities].get_function_values_from_local_dof_values(make_array_view(local), values);
+          for (auto &v : values)
+            v = Tensor<1, dim>();
+          for (unsigned int i = 0; i < local.size(); ++i)
+            {
+              const auto [c, base_i] = fe.system_to_component_index(i);
+              for (const unsigned int q : fe_u.quadrature_point_indices())
+                values[q][c] += local[i] * fe_u.shape_value(base_i, q);
+            }
           double cell_speed = 0.;
           for (const unsigned int q : fe_u.quadrature_point_indices())
             {

@@ -6,6 +6,7 @@
 #include <deal.II/dofs/dof_tools.h>
 #include <deal.II/fe/fe_dgq.h>
 #include <deal.II/fe/fe_values.h>
+#include <deal.II/lac/full_matrix.h>
 #include <deal.II/lac/read_write_vector.h>
 #include <deal.II/numerics/vector_tools.h>
 
@@ -171,9 +172,21 @@ namespace Suspension::Solid
     // crosses at the midpoints of a 24 x 24 (8 x 8 x 8) grid of sub-cells.
     const QIterated<dim> fine(QMidpoint<1>(), dim == 2 ? 24 : 8);
     const UpdateFlags    flags = update_values | update_JxW_values | update_quadrature_points;
-    FEValues<dim>        fe_values(fe, quadrature, flags), fe_fine(fe, fine, flags);
+    FEValues<dim>        fe_values(fe, quadrature, flags);
     FEValues<dim>        fe_u(space.fe_velocity, quadrature, update_values);
-    FEValues<dim>        fe_u_fine(space.fe_velocity, fine, update_values);
+    // On the sub-cells, the systems' FEValues would copy every shape value
+    // of every component at 576 points on every cut cell (the largest cost
+    // of this function): phi through its scalar element, u from a table of
+    // its scalar element's values at the sub-cell points (the same on every
+    // cell).
+    PhiValues<dim>       phi_fine_values(fe, fine, flags);
+    const auto          &fe_fine = phi_fine_values.fe_values();
+    const auto          &u_base  = space.fe_velocity.base_element(0);
+    FullMatrix<double>   u_shape(u_base.n_dofs_per_cell(), fine.size());
+    for (unsigned int i = 0; i < u_base.n_dofs_per_cell(); ++i)
+      for (unsigned int q = 0; q < fine.size(); ++q)
+        u_shape(i, q) = u_base.shape_value(i, fine.point(q));
+    Vector<double>       u_local(space.fe_velocity.n_dofs_per_cell());
     const FEValuesExtractors::Scalar phi_x(0);
     const FEValuesExtractors::Vector velocities(0);
     std::vector<double>         phi(quadrature.size()), phi_fine(fine.size());
@@ -231,14 +244,21 @@ namespace Suspension::Solid
           const bool cut = profiled || (lowest < 0.5 + margin && highest >= 0.5 - margin);
           if (cut)
             {
-              fe_fine.reinit(cell);
-              fe_u_fine.reinit(velocity_cell);
-              fe_fine[phi_x].get_function_values(solution, phi_fine);
+              phi_fine_values.reinit(cell, solution);
+              phi_fine = phi_fine_values.values();
               if (profiled)
                 for (const unsigned int q : fe_fine.quadrature_point_indices())
                   phi_fine[q] = transport.profile_value(cell->active_cell_index(),
                                                         fe_fine.quadrature_point(q), phi_fine[q]);
-              fe_u_fine[velocities].get_function_values(velocity, u_fine);
+              velocity_cell->get_dof_values(velocity, u_local);
+              for (auto &v : u_fine)
+                v = Tensor<1, dim>();
+              for (unsigned int i = 0; i < u_local.size(); ++i)
+                {
+                  const auto [c, base_i] = space.fe_velocity.system_to_component_index(i);
+                  for (unsigned int q = 0; q < fine.size(); ++q)
+                    u_fine[q][c] += u_local[i] * u_shape(base_i, q);
+                }
               for (const unsigned int q : fe_fine.quadrature_point_indices())
                 {
                   if (phi_fine[q] >= 0.5)
