@@ -29,6 +29,10 @@ table Study/Directory/study.csv and its figures (scripts/plot_study.py).
 test of resumption). --collect only writes the table and the figures from
 the cases finished so far (for example while a part of the study runs
 under --set 'Study/Volume fractions=...').
+--save-state archives the unfinished cases (checkpoint, statistics, logs;
+no field files) to study_state/<study directory>/<case>.tar.xz; a later
+run on another machine restores such a case before running it, so a study
+longer than a sitting can be committed part-way and carried on.
 """
 import argparse
 import csv
@@ -51,6 +55,10 @@ p.add_argument("--max-cases", type=int, default=0)
 p.add_argument("--exe", default=os.path.join(here, "..", "build", "suspension"))
 p.add_argument("--set", action="append", default=[], dest="sets")
 p.add_argument("--progress-seconds", type=float, default=30.)
+p.add_argument("--save-state", action="store_true",
+               help="archive every unfinished case that has a checkpoint (without its "
+               "field files) to study_state/<study directory>/<case>.tar.xz, for a "
+               "later sitting on another machine, and exit; stop the study first")
 p.add_argument("--collect", action="store_true",
                help="write study.csv and the figures from the finished cases; run nothing")
 a = p.parse_args()
@@ -73,6 +81,40 @@ os.makedirs(root, exist_ok=True)
 
 def directory(case):
     return case["set"]["Output/Directory"]
+
+
+# Unfinished cases carried between machines (--save-state): the case
+# directory without its field files, restored before the case runs.
+state_root = os.path.join(here, "..", "study_state", os.path.basename(os.path.normpath(root)))
+
+
+def state_archive(case):
+    return os.path.join(state_root, case["name"] + ".tar.xz")
+
+
+def save_state():
+    os.makedirs(state_root, exist_ok=True)
+    for case in cases:
+        d = directory(case)
+        if os.path.isdir(os.path.join(d, "checkpoint")) and \
+                not os.path.isfile(os.path.join(d, "case_done.json")):
+            subprocess.run(["tar", "-cJf", state_archive(case), "--exclude=*.vtu",
+                            "--exclude=*.pvtu", "--exclude=*.pvd", "-C",
+                            os.path.dirname(os.path.normpath(d)),
+                            os.path.basename(os.path.normpath(d))], check=True)
+            print(f"  saved {case['name']} at t = {simulated_time(case):g} -> "
+                  f"{os.path.relpath(state_archive(case))}", flush=True)
+
+
+def restore_state(case):
+    """A case not yet started here continues from an archived state."""
+    d = directory(case)
+    if os.path.isfile(state_archive(case)) and not os.path.isdir(os.path.join(d, "checkpoint")) \
+            and not os.path.isfile(os.path.join(d, "case_done.json")):
+        subprocess.run(["tar", "-xJf", state_archive(case), "-C",
+                        os.path.dirname(os.path.normpath(d))], check=True)
+        print(f"  restored {case['name']} from {os.path.relpath(state_archive(case))}",
+              flush=True)
 
 
 def done(case):
@@ -221,6 +263,9 @@ def terminated(signum, frame):
 
 
 signal.signal(signal.SIGTERM, terminated)
+if a.save_state:
+    save_state()
+    sys.exit(0)
 if a.collect:
     collect()
     print(f"study: {sum(done(c) for c in cases)}/{len(cases)} cases done in {root} (collected)",
@@ -240,6 +285,7 @@ try:
         while (pending and len(running) < jobs and
                (a.max_cases == 0 or finished_now + len(running) < a.max_cases)):
             case = pending.pop(0)
+            restore_state(case)
             if os.path.isfile(os.path.join(directory(case), "case_done.json")):
                 extend(case)
             os.makedirs(directory(case), exist_ok=True)
