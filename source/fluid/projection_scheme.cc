@@ -3,6 +3,7 @@
 #include <deal.II/lac/full_matrix.h>
 #include <deal.II/numerics/vector_tools.h>
 
+#include <suspension/core/vector_values.h>
 #include <suspension/fluid/projection_scheme.h>
 
 #include <petscmat.h>
@@ -681,8 +682,7 @@ namespace Suspension::Fluid
   FlowDiagnostics ProjectionScheme<dim>::compute_diagnostics() const
   {
     FlowDiagnostics d;
-    // the scalar element's FEValues and the components summed here: the
-    // system's FEValues would copy all its shape values on every cell
+    // the scalar element's FEValues (see vector_values.h)
     const auto   &fe     = space.fe_velocity;
     FEValues<dim> fe_u(fe.base_element(0), space.quadrature, update_values | update_JxW_values);
     std::vector<Tensor<1, dim>> values(space.quadrature.size());
@@ -694,14 +694,9 @@ namespace Suspension::Fluid
         {
           fe_u.reinit(typename Triangulation<dim>::cell_iterator(cell));
           cell->get_dof_values(velocity_ghosted, local);
-          for (auto &v : values)
-            v = Tensor<1, dim>();
-          for (unsigned int i = 0; i < local.size(); ++i)
-            {
-              const auto [c, base_i] = fe.system_to_component_index(i);
-              for (const unsigned int q : fe_u.quadrature_point_indices())
-                values[q][c] += local[i] * fe_u.shape_value(base_i, q);
-            }
+          vector_values_from_scalar_base(
+            fe, local, [&](const unsigned int i, const unsigned int q) { return fe_u.shape_value(i, q); },
+            values);
           double cell_speed = 0.;
           for (const unsigned int q : fe_u.quadrature_point_indices())
             {

@@ -11,6 +11,7 @@
 #include <deal.II/numerics/vector_tools.h>
 
 #include <suspension/core/scene.h>
+#include <suspension/core/vector_values.h>
 #include <suspension/postprocess/point_values.h>
 #include <suspension/solid/phi_values.h>
 #include <suspension/solid/solid_phase.h>
@@ -251,14 +252,7 @@ namespace Suspension::Solid
                   phi_fine[q] = transport.profile_value(cell->active_cell_index(),
                                                         fe_fine.quadrature_point(q), phi_fine[q]);
               velocity_cell->get_dof_values(velocity, u_local);
-              for (auto &v : u_fine)
-                v = Tensor<1, dim>();
-              for (unsigned int i = 0; i < u_local.size(); ++i)
-                {
-                  const auto [c, base_i] = space.fe_velocity.system_to_component_index(i);
-                  for (unsigned int q = 0; q < fine.size(); ++q)
-                    u_fine[q][c] += u_local[i] * u_shape(base_i, q);
-                }
+              vector_values_from_scalar_base(space.fe_velocity, u_local, u_shape, u_fine);
               for (const unsigned int q : fe_fine.quadrature_point_indices())
                 {
                   if (phi_fine[q] >= 0.5)
