@@ -172,26 +172,31 @@ namespace Suspension::Solid
     // (statistics.txt) it is also measured on cells that the level 1/2
     // crosses at the midpoints of a 24 x 24 (8 x 8 x 8) grid of sub-cells.
     const QIterated<dim> fine(QMidpoint<1>(), dim == 2 ? 24 : 8);
-    const UpdateFlags    flags = update_values | update_JxW_values | update_quadrature_points;
-    FEValues<dim>        fe_values(fe, quadrature, flags);
-    FEValues<dim>        fe_u(space.fe_velocity, quadrature, update_values);
-    // On the sub-cells, the systems' FEValues would copy every shape value
-    // of every component at 576 points on every cut cell (the largest cost
-    // of this function): phi through its scalar element, u from a table of
-    // its scalar element's values at the sub-cell points (the same on every
-    // cell).
-    PhiValues<dim>       phi_fine_values(fe, fine, flags);
-    const auto          &fe_fine = phi_fine_values.fe_values();
-    const auto          &u_base  = space.fe_velocity.base_element(0);
-    FullMatrix<double>   u_shape(u_base.n_dofs_per_cell(), fine.size());
-    for (unsigned int i = 0; i < u_base.n_dofs_per_cell(); ++i)
-      for (unsigned int q = 0; q < fine.size(); ++q)
-        u_shape(i, q) = u_base.shape_value(i, fine.point(q));
-    Vector<double>       u_local(space.fe_velocity.n_dofs_per_cell());
-    const FEValuesExtractors::Scalar phi_x(0);
-    const FEValuesExtractors::Vector velocities(0);
-    std::vector<double>         phi(quadrature.size()), phi_fine(fine.size());
-    std::vector<Tensor<1, dim>> u(quadrature.size()), u_fine(fine.size());
+    // This runs every step. FEValues on the systems copied every shape value
+    // of every component on every cell (the largest cost of this function):
+    // phi goes through its scalar element, u and phi at the sub-cell points
+    // through tables of the scalar elements' values there, the same on
+    // every cell, and the sub-cells' midpoints follow from the cell's box
+    // (every cell of a box or channel is axis-parallel). B is read only on
+    // the cells of the core.
+    PhiValues<dim>     phi_values(fe, quadrature, update_JxW_values | update_quadrature_points);
+    const auto        &fe_gauss = phi_values.fe_values();
+    FEValues<dim>      fe_B(fe, quadrature, update_values);
+    const auto tabulate = [](const FiniteElement<dim> &base, const Quadrature<dim> &points) {
+      FullMatrix<double> shape(base.n_dofs_per_cell(), points.size());
+      for (unsigned int i = 0; i < base.n_dofs_per_cell(); ++i)
+        for (unsigned int q = 0; q < points.size(); ++q)
+          shape(i, q) = base.shape_value(i, points.point(q));
+      return shape;
+    };
+    const auto              &u_base     = space.fe_velocity.base_element(0);
+    const FullMatrix<double> u_gauss    = tabulate(u_base, quadrature);
+    const FullMatrix<double> u_fine     = tabulate(u_base, fine);
+    const FullMatrix<double> phi_fine_shape = tabulate(fe.base_element(0), fine);
+    Vector<double>           u_local(space.fe_velocity.n_dofs_per_cell());
+    std::vector<Tensor<1, dim>> u(quadrature.size());
+    std::vector<double>         phi_fine(fine.size());
+    std::vector<Point<dim>>     x_fine(fine.size());
     Vector<double>              local(fe.n_dofs_per_cell());
     // moments of three sets, V, V x, V u, V x x^T (unrolled): the stress
     // weight H(phi) (the particle is where it would carry stress: its
@@ -230,44 +235,60 @@ namespace Suspension::Solid
               }
           // with 'Shape measure = profile' the interface inside a cut cell
           // is the profile the transport carries
-          const bool profiled = shape_on_profile && transport.has_profile(cell->active_cell_index());
+          const auto *profile =
+            shape_on_profile ? transport.profile(cell->active_cell_index()) : nullptr;
+          const bool profiled = profile != nullptr;
           // Most cells hold only fluid: every moment below is weighted by
           // phi or by a weight that vanishes with it, so they add (next to)
           // nothing, and evaluating them was most of this function's cost.
           if (std::max(highest, -lowest) < 1e-12 && !profiled)
             continue;
-          fe_values.reinit(cell);
-          const auto velocity_cell = Fluid::FluidSpace<dim>::cell_of(cell, space.dof_velocity);
-          fe_u.reinit(velocity_cell);
-          fe_values[phi_x].get_function_values(solution, phi);
-          fe_u[velocities].get_function_values(velocity, u);
+          phi_values.reinit(cell, solution);
+          const auto &phi           = phi_values.values();
+          const auto  velocity_cell = Fluid::FluidSpace<dim>::cell_of(cell, space.dof_velocity);
+          velocity_cell->get_dof_values(velocity, u_local);
+          vector_values_from_scalar_base(space.fe_velocity, u_local, u_gauss, u);
           const double margin = fe.degree > 1 ? 0.1 : 0.;
           const bool cut = profiled || (lowest < 0.5 + margin && highest >= 0.5 - margin);
           if (cut)
             {
-              phi_fine_values.reinit(cell, solution);
-              phi_fine = phi_fine_values.values();
-              if (profiled)
-                for (const unsigned int q : fe_fine.quadrature_point_indices())
-                  phi_fine[q] = transport.profile_value(cell->active_cell_index(),
-                                                        fe_fine.quadrature_point(q), phi_fine[q]);
-              velocity_cell->get_dof_values(velocity, u_local);
-              vector_values_from_scalar_base(space.fe_velocity, u_local, u_shape, u_fine);
-              for (const unsigned int q : fe_fine.quadrature_point_indices())
+              const Point<dim> corner = cell->vertex(0);
+              const Point<dim> far    = cell->vertex(GeometryInfo<dim>::vertices_per_cell - 1);
+              double           volume = 1.;
+              for (unsigned int d = 0; d < dim; ++d)
+                volume *= far[d] - corner[d];
+              // the DG polynomial only where the profile does not replace it
+              const bool  dg_needed = !profiled || profile->weight != 1.;
+              const auto &phi_dofs  = phi_values.dof_values();
+              for (unsigned int q = 0; q < fine.size(); ++q)
                 {
+                  for (unsigned int d = 0; d < dim; ++d)
+                    x_fine[q][d] = corner[d] + (far[d] - corner[d]) * fine.point(q)[d];
+                  double value = 0.;
+                  if (dg_needed)
+                    for (unsigned int i = 0; i < phi_dofs.size(); ++i)
+                      value += phi_dofs[i] * phi_fine_shape(i, q);
+                  phi_fine[q] = profiled ? profile->value(x_fine[q], value) : value;
+                }
+              for (unsigned int q = 0; q < fine.size(); ++q)
+                {
+                  const double H = profiled ? weight(phi_fine[q]) : 0.;
+                  if (phi_fine[q] < 0.5 && H == 0.)
+                    continue;
+                  const double JxW = fine.weight(q) * volume;
+                  const auto   u_q = vector_value_from_scalar_base(space.fe_velocity, u_local, u_fine, q);
                   if (phi_fine[q] >= 0.5)
                     {
-                      m[3 * n_m + 1] += fe_fine.JxW(q);
-                      add(&m[2 * n_m], fe_fine.JxW(q), fe_fine.quadrature_point(q), u_fine[q]);
+                      m[3 * n_m + 1] += JxW;
+                      add(&m[2 * n_m], JxW, x_fine[q], u_q);
                     }
                   // the profile is a step within a fraction of the cell,
                   // which a few Gauss points would snap to: the stress
                   // weight's moments and the area on the sub-cells
                   if (profiled)
                     {
-                      m[3 * n_m] += (phi_fine[q] >= 0.5 ? fe_fine.JxW(q) : 0.);
-                      add(&m[0], weight(phi_fine[q]) * fe_fine.JxW(q), fe_fine.quadrature_point(q),
-                          u_fine[q]);
+                      m[3 * n_m] += (phi_fine[q] >= 0.5 ? JxW : 0.);
+                      add(&m[0], H * JxW, x_fine[q], u_q);
                     }
                 }
             }
@@ -275,27 +296,30 @@ namespace Suspension::Solid
           const bool core_cell =
             elastic && weight(*std::max_element(phi.begin(), phi.end())) >= 1.;
           if (core_cell)
-            fe_values[B_x].get_function_values(solution, B);
-          for (const unsigned int q : fe_values.quadrature_point_indices())
             {
-              const auto &x = fe_values.quadrature_point(q);
+              fe_B.reinit(cell);
+              fe_B[B_x].get_function_values(solution, B);
+            }
+          for (const unsigned int q : fe_gauss.quadrature_point_indices())
+            {
+              const auto  &x   = fe_gauss.quadrature_point(q);
+              const double JxW = fe_gauss.JxW(q);
               if (!profiled)
-                m[3 * n_m] += (phi[q] >= 0.5 ? fe_values.JxW(q) : 0.);
+                m[3 * n_m] += (phi[q] >= 0.5 ? JxW : 0.);
               if (!cut && lowest >= 0.5)
                 {
-                  m[3 * n_m + 1] += fe_values.JxW(q);
-                  add(&m[2 * n_m], fe_values.JxW(q), x, u[q]);
+                  m[3 * n_m + 1] += JxW;
+                  add(&m[2 * n_m], JxW, x, u[q]);
                 }
               if (core_cell && weight(phi[q]) >= 1.)
                 {
-                  core[0] += fe_values.JxW(q);
+                  core[0] += JxW;
                   for (unsigned int k = 0; k < n_B; ++k)
-                    core[1 + k] += fe_values.JxW(q) *
-                                   B[q].access_raw_entry(k);
+                    core[1 + k] += JxW * B[q].access_raw_entry(k);
                 }
               if (!profiled)
-                add(&m[0], weight(phi[q]) * fe_values.JxW(q), x, u[q]);
-              add(&m[n_m], phi[q] * fe_values.JxW(q), x, u[q]);
+                add(&m[0], weight(phi[q]) * JxW, x, u[q]);
+              add(&m[n_m], phi[q] * JxW, x, u[q]);
             }
         }
     Utilities::MPI::sum(m, dof_handler.get_communicator(), m);

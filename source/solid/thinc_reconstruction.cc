@@ -322,23 +322,36 @@ namespace Suspension::Solid
   }
 
   template <int dim>
-  bool TransportOperator<dim>::has_profile(const unsigned int active_cell_index) const
+  const typename TransportOperator<dim>::Reconstruction *
+  TransportOperator<dim>::profile(const unsigned int active_cell_index) const
   {
     if (!(thinc_beta > 0.))
-      return false;
+      return nullptr;
     const unsigned int k = owned_cell_lane[active_cell_index];
     Assert(k != numbers::invalid_unsigned_int, ExcMessage("not a locally owned cell"));
-    return reconstruction[k / VA::size()][k % VA::size()].weight > 0.;
+    const auto &r = reconstruction[k / VA::size()][k % VA::size()];
+    return r.weight > 0. ? &r : nullptr;
+  }
+
+  template <int dim>
+  bool TransportOperator<dim>::has_profile(const unsigned int active_cell_index) const
+  {
+    return profile(active_cell_index) != nullptr;
+  }
+
+  template <int dim>
+  double TransportOperator<dim>::Reconstruction::value(const Point<dim> &x,
+                                                       const double      dg_value) const
+  {
+    return profile_phi(*this, x, dg_value);
   }
 
   template <int dim>
   double TransportOperator<dim>::profile_value(const unsigned int active_cell_index,
                                                const Point<dim> &x, const double dg_value) const
   {
-    if (!has_profile(active_cell_index))
-      return dg_value;
-    const unsigned int k = owned_cell_lane[active_cell_index];
-    return profile_phi(reconstruction[k / VA::size()][k % VA::size()], x, dg_value);
+    const Reconstruction *r = profile(active_cell_index);
+    return r ? r->value(x, dg_value) : dg_value;
   }
 
   template <int dim>

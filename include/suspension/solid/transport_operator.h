@@ -214,7 +214,15 @@ namespace Suspension::Solid
       /// the cell's box: a point of a periodic face, given in the
       /// coordinates of the other side, is moved onto this cell's face
       Point<dim> lower, upper;
+
+      /// phi of this profile at x: p + w (H - p), p = `dg_value`
+      double value(const Point<dim> &x, double dg_value) const;
     };
+
+    /// The profile of the locally owned cell with this active_cell_index(),
+    /// or nullptr where it has none (what profile_value() evaluates, for
+    /// loops over many points of one cell).
+    const Reconstruction *profile(unsigned int active_cell_index) const;
 
     /// The THINC profile of a cell of phi mean `mean` and reference-cell
     /// gradient integral `gradient` (the cell [x0, x0 + h], axis-parallel),
