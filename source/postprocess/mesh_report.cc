@@ -10,12 +10,14 @@ namespace Suspension::Postprocess
     : with_solid(with_solid)
   {}
 
-  void MeshReport::record(TableHandler &statistics, const MeshLevels &levels, const bool adapted,
-                          const double seconds)
+  void MeshReport::record(TableHandler &statistics, const bool row, const MeshLevels &levels,
+                          const bool adapted, const double seconds)
   {
     worst_coarse_interface = std::max(worst_coarse_interface, levels.coarse_interface_cells);
     if (adapted)
       ++n_adaptations;
+    if (!row)
+      return;
     statistics.add_value("level_min", levels.min_level);
     statistics.add_value("level_max", levels.max_level);
     statistics.add_value("cells_finest", static_cast<unsigned long long>(levels.cells_on_finest));

@@ -59,6 +59,16 @@ namespace Suspension::Parameters
                       Patterns::Integer(0),
                       "Print one progress line (step, time, dt, ETA) every "
                       "this many steps (0: never).");
+    prm.declare_entry("Statistics interval",
+                      std::to_string(d.statistics_interval),
+                      Patterns::Integer(1),
+                      "Add a row to statistics.txt every this many steps "
+                      "(and at the first). A row measures the particle's "
+                      "shape on sub-cells when the scene has one particle, "
+                      "the most expensive diagnostic of a step; the "
+                      "largest area error of the run summary is taken over "
+                      "these rows. The time averages of 'Statistics' are "
+                      "sampled by their own 'Sample interval'.");
     prm.declare_entry("Timer summary",
                       "true",
                       Patterns::Bool(),
@@ -83,6 +93,7 @@ namespace Suspension::Parameters
     interval_steps    = prm.get_integer("Interval steps");
     interval_time     = prm.get_double("Interval time");
     progress_interval = prm.get_integer("Progress interval");
+    statistics_interval = prm.get_integer("Statistics interval");
     timer_summary     = prm.get_bool("Timer summary");
     run_header        = prm.get_bool("Run header");
     const std::string points = prm.get("Probe points");

@@ -147,6 +147,7 @@ namespace Suspension
     double                                    initial_memory_estimate = 0.;
     double                                    last_output_time   = 0.;
     double                                    last_driving_force = 0.;
+    bool                                      statistics_row     = true; // this step adds a row
     unsigned int                              n_outputs          = 0;
     Checkpoint<dim>                           checkpoint;
     double wall_time_before = 0.; // of the run up to the checkpoint it resumed from

@@ -24,7 +24,8 @@ namespace Suspension::Postprocess
 
     /// the mesh a step ran on; adapted: it was changed for the next one,
     /// which took 'seconds'
-    void record(TableHandler &statistics, const MeshLevels &levels, bool adapted,
+    /// counts the adaptation; with `row`, adds the step's columns to statistics
+    void record(TableHandler &statistics, bool row, const MeshLevels &levels, bool adapted,
                 double seconds);
     void report(std::ostream &out, types::global_cell_index n_cells) const;
 

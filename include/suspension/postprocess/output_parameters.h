@@ -23,6 +23,7 @@ namespace Suspension::Parameters
     double                          interval_time  = 0.;
     std::vector<std::vector<double>> probe_points;
     unsigned int                    progress_interval = 10;
+    unsigned int                    statistics_interval = 1; // steps per row of statistics.txt
     bool                            timer_summary     = true;
     bool                            run_header        = true;
 
