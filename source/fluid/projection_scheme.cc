@@ -335,12 +335,6 @@ namespace Suspension::Fluid
       make_step_constraints();
     assemble_momentum_rhs(load, dt, t_new, sources);
     const double tolerance = parameters.fluid_solver.solver_tolerance;
-    // The solver's first guess: u^n extrapolated to t^{n+1}, whose residual
-    // is O(dt^2) instead of O(dt); the tolerance is relative to the
-    // right-hand side, so the solve stops at the same accuracy after fewer
-    // iterations (doc/performance.md, session 27).
-    if (extrapolation > 0.)
-      u.sadd(1. + extrapolation, -extrapolation, u_older);
     if (operators.step_matrix)
       {
         section.next("fluid: semi-implicit preconditioner");
