@@ -334,24 +334,10 @@ namespace Suspension::Solid
   }
 
   template <int dim>
-  bool TransportOperator<dim>::has_profile(const unsigned int active_cell_index) const
-  {
-    return profile(active_cell_index) != nullptr;
-  }
-
-  template <int dim>
   double TransportOperator<dim>::Reconstruction::value(const Point<dim> &x,
                                                        const double      dg_value) const
   {
     return profile_phi(*this, x, dg_value);
-  }
-
-  template <int dim>
-  double TransportOperator<dim>::profile_value(const unsigned int active_cell_index,
-                                               const Point<dim> &x, const double dg_value) const
-  {
-    const Reconstruction *r = profile(active_cell_index);
-    return r ? r->value(x, dg_value) : dg_value;
   }
 
   template <int dim>

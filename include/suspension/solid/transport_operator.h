@@ -181,20 +181,10 @@ namespace Suspension::Solid
     /// Returns whether it did (only with the reconstruction on).
     bool project_to_profiles(VectorType &solution) const;
 
-    /// The THINC profiles of the current solution, for profile_value():
+    /// The THINC profiles of the current solution, for profile():
     /// what project_to_profiles() computes, without changing the solution.
     /// Nothing without the reconstruction.
     void update_profiles(const VectorType &solution) const;
-
-    /// phi as the transport carries it at the point x of the locally owned
-    /// cell with this active_cell_index(): the cell's THINC profile (p + w
-    /// (H - p)) if it has one, else `dg_value`, the DG polynomial at x.
-    /// The profiles are those of the last update_profiles() or
-    /// project_to_profiles().
-    double profile_value(unsigned int active_cell_index, const Point<dim> &x, double dg_value) const;
-
-    /// whether that cell has a profile (it is cut by the interface)
-    bool has_profile(unsigned int active_cell_index) const;
 
     /// The profile of one cell as a function of x: 1/2 (1 + tanh(slope.x +
     /// offset)), or none (the DG polynomial is used).
@@ -220,8 +210,8 @@ namespace Suspension::Solid
     };
 
     /// The profile of the locally owned cell with this active_cell_index(),
-    /// or nullptr where it has none (what profile_value() evaluates, for
-    /// loops over many points of one cell).
+    /// or nullptr where it has none (the cell is not cut, or THINC is off):
+    /// Reconstruction::value() is phi as the transport carries it there.
     const Reconstruction *profile(unsigned int active_cell_index) const;
 
     /// The THINC profile of a cell of phi mean `mean` and reference-cell
