@@ -371,7 +371,14 @@ namespace Suspension
     const MeshLevels levels = adaptor.levels(solid.get());
     bool       adapted      = false;
     const auto adapt_start  = std::chrono::steady_clock::now();
-    if (adaptor.due(flow_diagnostics.max_speed * dt))
+    // The band of finest cells is due to move once the interface may have
+    // crossed its buffer: at the interface's own speed (a disc in a
+    // cavity moves at a fraction of the lid's speed), unless the velocity
+    // is refined too (Kelly), which follows the fastest fluid.
+    const double speed = solid && adaptor.follows_interface_only() ?
+                           solid->interface_speed(adaptor.interface_threshold()) :
+                           flow_diagnostics.max_speed;
+    if (adaptor.due(speed * dt, levels))
       adapted = adapt_mesh();
     if (adapted)
       {

@@ -141,16 +141,23 @@ namespace Suspension::Fluid
     std::vector<Vector> components(dim);
     for (auto &v : components)
       matrix_free.initialize_dof_vector(v);
+    // only the terms with a non-zero coefficient: the mass diagonal needs
+    // no gradients, the viscous one no values
+    const EvaluationFlags::EvaluationFlags flags =
+      (mass != 0. ? EvaluationFlags::values : EvaluationFlags::nothing) |
+      (viscosity != 0. ? EvaluationFlags::gradients : EvaluationFlags::nothing);
     for (unsigned int c = 0; c < dim; ++c)
       MatrixFreeTools::compute_diagonal<dim, fe_degree, n_q, 1, double, VectorizedArray<double>>(
         matrix_free, components, [&](FEEvaluation<dim, fe_degree, n_q, 1, double> &u) {
-          u.evaluate(EvaluationFlags::values | EvaluationFlags::gradients);
+          u.evaluate(flags);
           for (const unsigned int q : u.quadrature_point_indices())
             {
-              u.submit_value(mass * u.get_value(q), q);
-              u.submit_gradient(viscosity * u.get_gradient(q), q);
+              if (mass != 0.)
+                u.submit_value(mass * u.get_value(q), q);
+              if (viscosity != 0.)
+                u.submit_gradient(viscosity * u.get_gradient(q), q);
             }
-          u.integrate(EvaluationFlags::values | EvaluationFlags::gradients);
+          u.integrate(flags);
         },
         0, 0, c);
     for (const auto &v : components)

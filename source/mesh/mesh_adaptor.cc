@@ -42,7 +42,7 @@ namespace Suspension
   }
 
   template <int dim>
-  bool MeshAdaptor<dim>::due(const double distance_moved)
+  bool MeshAdaptor<dim>::due(const double distance_moved, const MeshLevels &levels)
   {
     if (!settings.enabled)
       return false;
@@ -51,7 +51,8 @@ namespace Suspension
     const bool now =
       settings.interval > 0 ?
         steps_since >= settings.interval :
-        distance_since >= settings.buffer_fraction * settings.buffer_cells * finest_cell_size();
+        (distance_since >= settings.buffer_fraction * settings.buffer_cells * finest_cell_size() ||
+         levels.interface_near_coarse_cells);
     if (now)
       {
         steps_since    = 0;
@@ -268,7 +269,25 @@ namespace Suspension
               static_cast<unsigned int>(cell->level()) < finest_level)
             ++coarse_interface;
         }
+    // the interface band widened by the margin (due()) reaching a cell
+    // below the finest level
+    bool near_coarse = false;
+    if (solid && settings.enabled)
+      {
+        const unsigned int margin = std::max(
+          1, static_cast<int>(std::floor((1. - settings.buffer_fraction) * settings.buffer_cells)));
+        std::vector<unsigned char> band(triangulation.n_active_cells(), 0);
+        for (unsigned int i = 0; i < band.size(); ++i)
+          band[i] = phase[i] == Solid::interface_cell;
+        dilate(band, margin);
+        for (const auto &cell : triangulation.active_cell_iterators())
+          if (cell->is_locally_owned() && band[cell->active_cell_index()] &&
+              static_cast<unsigned int>(cell->level()) < finest_level)
+            near_coarse = true;
+        near_coarse = Utilities::MPI::logical_or(near_coarse, comm);
+      }
     MeshLevels l;
+    l.interface_near_coarse_cells = near_coarse;
     l.min_level              = lo;
     l.max_level              = hi;
     l.cells_on_finest        = Utilities::MPI::sum(finest, comm);

@@ -93,10 +93,12 @@ namespace Suspension::Parameters
                       "so that the interface cannot cross 'Buffer fraction' "
                       "of the buffer between two adaptations (doc/method.md).");
     prm.declare_entry("Buffer fraction", "0.5", Patterns::Double(0.05, 1.),
-                      "With Interval = 0: adapt once the fastest material "
-                      "point may have moved this fraction of 'Buffer cells' "
-                      "finest cells. Larger: fewer adaptations, a thinner "
-                      "margin before the interface leaves the finest band.");
+                      "With Interval = 0: adapt once the interface (the "
+                      "fastest |u| over the cells it crosses; with Kelly "
+                      "refinement the fastest material point) may have moved "
+                      "this fraction of 'Buffer cells' finest cells. Larger: "
+                      "fewer adaptations, a thinner margin before the "
+                      "interface leaves the finest band.");
     prm.declare_entry("Initial cycles", std::to_string(d.initial_cycles),
                       Patterns::Integer(0, 20),
                       "Adapt-and-reinitialise cycles on the initial condition; "

@@ -194,6 +194,28 @@ namespace Suspension::Solid
     const FullMatrix<double> u_fine     = tabulate(u_base, fine);
     const FullMatrix<double> phi_fine_shape = tabulate(fe.base_element(0), fine);
     Vector<double>           u_local(space.fe_velocity.n_dofs_per_cell());
+    // the (component, base index) of each velocity DoF, looked up once
+    std::vector<std::pair<unsigned int, unsigned int>> u_index(u_local.size());
+    for (unsigned int i = 0; i < u_local.size(); ++i)
+      u_index[i] = space.fe_velocity.system_to_component_index(i);
+    // u at sub-cell point q: the sum of vector_value_from_scalar_base, in its order
+    const auto u_at_fine = [&](const unsigned int q) {
+      Tensor<1, dim> value;
+      for (unsigned int i = 0; i < u_index.size(); ++i)
+        value[u_index[i].first] += u_local[i] * u_fine(u_index[i].second, q);
+      return value;
+    };
+    // Where the profile alone is phi (its weight 1) and H is the sharp
+    // step, phi = 1 / (1 + exp(-2a)) at a sub-cell point is needed only
+    // where H is strictly between 0 and 1, a in (atanh(2 lower - 1),
+    // atanh(2 upper - 1)): beyond, phi >= 1/2 and H follow from the sign
+    // of a (with a margin far above the exponential's round-off, so the
+    // answers are those of the computed phi). Most sub-cell points are
+    // beyond, and the exponential was the largest cost of this loop.
+    const auto   band_end = [](const double level) {
+      return level <= 0. ? -1e300 : (level >= 1. ? 1e300 : std::atanh(2. * level - 1.));
+    };
+    const double a_lower = band_end(weight.lower) - 1e-9, a_upper = band_end(weight.upper) + 1e-9;
     std::vector<Tensor<1, dim>> u(quadrature.size());
     std::vector<double>         phi_fine(fine.size());
     std::vector<Point<dim>>     x_fine(fine.size());
@@ -259,11 +281,20 @@ namespace Suspension::Solid
                 volume *= far[d] - corner[d];
               // the DG polynomial only where the profile does not replace it
               const bool  dg_needed = !profiled || profile->weight != 1.;
+              const bool  by_argument = !dg_needed && weight.sharp;
               const auto &phi_dofs  = phi_values.dof_values();
               for (unsigned int q = 0; q < fine.size(); ++q)
                 {
                   for (unsigned int d = 0; d < dim; ++d)
                     x_fine[q][d] = corner[d] + (far[d] - corner[d]) * fine.point(q)[d];
+                  if (by_argument)
+                    {
+                      const double a = profile->argument(x_fine[q]);
+                      phi_fine[q]    = a > a_upper ? 1. :
+                                       a < a_lower ? 0. :
+                                                     1. / (1. + std::exp(-2. * a));
+                      continue;
+                    }
                   double value = 0.;
                   if (dg_needed)
                     for (unsigned int i = 0; i < phi_dofs.size(); ++i)
@@ -276,7 +307,7 @@ namespace Suspension::Solid
                   if (phi_fine[q] < 0.5 && H == 0.)
                     continue;
                   const double JxW = fine.weight(q) * volume;
-                  const auto   u_q = vector_value_from_scalar_base(space.fe_velocity, u_local, u_fine, q);
+                  const auto   u_q = u_at_fine(q);
                   if (phi_fine[q] >= 0.5)
                     {
                       m[3 * n_m + 1] += JxW;

@@ -355,6 +355,9 @@ namespace Suspension::Solid
   {
     copy_velocity(u_begin, u0);
     copy_velocity(u_end, u1);
+    // ghosted for interface_speed()
+    u0.update_ghost_values();
+    u1.update_ghost_values();
     const double sub_steps = std::max(1., std::ceil(dt / max_substep(speed_over_h) - 1e-12));
     // A flow that blew up without (yet) a NaN would make the transport
     // crawl through millions of sub-steps: stop with the reason instead.

@@ -341,6 +341,12 @@ namespace Suspension::Solid
   }
 
   template <int dim>
+  double TransportOperator<dim>::Reconstruction::argument(const Point<dim> &x) const
+  {
+    return profile_argument(*this, x);
+  }
+
+  template <int dim>
   bool TransportOperator<dim>::project_to_profiles(VectorType &solution) const
   {
     if (!(thinc_beta > 0.))

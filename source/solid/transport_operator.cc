@@ -287,14 +287,14 @@ namespace Suspension::Solid
   }
 
   template <int dim>
-  void TransportOperator<dim>::mark_solid_cells(const VectorType &solution)
+  template <typename Holds>
+  std::vector<unsigned char> TransportOperator<dim>::cells_near(const VectorType &solution,
+                                                                const Holds      &holds_at) const
   {
-    if (!with_B)
-      return;
-    constexpr double   threshold = 1e-8;
-    const unsigned int n_lanes   = VectorizedArray<double>::size();
-    const auto        &tria      = matrix_free.get_dof_handler(0).get_triangulation();
-    // 1. cells that hold solid (owned), then their owners' marks on the ghosts
+    const unsigned int n_lanes = VectorizedArray<double>::size();
+    const auto        &tria    = matrix_free.get_dof_handler(0).get_triangulation();
+    // 1. the owned cells whose nodal values of phi satisfy holds_at(lowest,
+    // highest), then their owners' marks on the ghosts
     std::vector<unsigned char> holds(tria.n_active_cells(), 0), marked;
     FEEvaluation<dim, -1, 0, 1, double> phi(matrix_free, 0, 0, 0);
     for (unsigned int cell = 0; cell < matrix_free.n_cell_batches(); ++cell)
@@ -302,12 +302,15 @@ namespace Suspension::Solid
         phi.reinit(cell);
         phi.read_dof_values_plain(solution);
         for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
-          for (unsigned int i = 0; i < phi.dofs_per_cell; ++i)
-            if (phi.begin_dof_values()[i][v] > threshold)
+          {
+            double lowest = phi.begin_dof_values()[0][v], highest = lowest;
+            for (unsigned int i = 1; i < phi.dofs_per_cell; ++i)
               {
-                holds[lane_cell_index[cell * n_lanes + v]] = 1;
-                break;
+                lowest  = std::min(lowest, phi.begin_dof_values()[i][v]);
+                highest = std::max(highest, phi.begin_dof_values()[i][v]);
               }
+            holds[lane_cell_index[cell * n_lanes + v]] = holds_at(lowest, highest);
+          }
       }
     const auto exchange = [&](std::vector<unsigned char> &flags) {
       using Iterator = typename Triangulation<dim>::active_cell_iterator;
@@ -332,12 +335,60 @@ namespace Suspension::Solid
           }
       }
     exchange(marked);
+    return marked;
+  }
+
+  template <int dim>
+  void TransportOperator<dim>::mark_solid_cells(const VectorType &solution)
+  {
+    if (!with_B)
+      return;
+    const unsigned int n_lanes = VectorizedArray<double>::size();
+    const std::vector<unsigned char> marked =
+      cells_near(solution, [](const double, const double highest) { return highest > 1e-8; });
     for (unsigned int cell = 0; cell < b_active.size(); ++cell)
       for (unsigned int v = 0; v < n_lanes; ++v)
         {
           const unsigned int index = lane_cell_index[cell * n_lanes + v];
           b_active[cell][v] = (index != numbers::invalid_unsigned_int && marked[index]) ? 1. : 0.;
         }
+  }
+
+  template <int dim>
+  double TransportOperator<dim>::interface_speed(const VectorType &solution,
+                                                 const VectorType &u0,
+                                                 const VectorType &u1,
+                                                 const double      epsilon) const
+  {
+    const unsigned int n_lanes = VectorizedArray<double>::size();
+    const std::vector<unsigned char> marked =
+      cells_near(solution, [epsilon](const double lowest, const double highest) {
+        return highest > epsilon && lowest < 1. - epsilon;
+      });
+    FEEvaluation<dim, -1, 0, dim, double> u(matrix_free, 1, 0);
+    double speed = 0.;
+    for (unsigned int cell = 0; cell < matrix_free.n_cell_batches(); ++cell)
+      {
+        bool any = false;
+        for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+          any = any || marked[lane_cell_index[cell * n_lanes + v]];
+        if (!any)
+          continue;
+        u.reinit(cell);
+        for (const VectorType *velocity : {&u0, &u1})
+          {
+            u.read_dof_values_plain(*velocity);
+            u.evaluate(EvaluationFlags::values);
+            for (const unsigned int q : u.quadrature_point_indices())
+              {
+                const VectorizedArray<double> norm = u.get_value(q).norm();
+                for (unsigned int v = 0; v < matrix_free.n_active_entries_per_cell_batch(cell); ++v)
+                  if (marked[lane_cell_index[cell * n_lanes + v]])
+                    speed = std::max(speed, norm[v]);
+              }
+          }
+      }
+    return Utilities::MPI::max(speed, matrix_free.get_dof_handler(0).get_communicator());
   }
 
   template class TransportOperator<2>;

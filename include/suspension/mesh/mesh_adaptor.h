@@ -21,6 +21,10 @@ namespace Suspension
     /// interface cells (see SolidPhase::classify_cells) below the finest
     /// level: 0 if the adaptation kept up with the interface
     types::global_cell_index coarse_interface_cells = 0;
+    /// whether an interface cell is within the band's margin (see
+    /// MeshAdaptor::due()) of a cell below the finest level: the band
+    /// must move now
+    bool interface_near_coarse_cells = false;
   };
 
   /**
@@ -52,13 +56,26 @@ namespace Suspension
     /// smallest cell now, on an adaptive one that of the maximum level.
     double finest_cell_size() const;
 
-    /// Called once per step with the distance the fastest material point
-    /// moved (max |u| dt): true when the mesh should be adapted now. With
-    /// a fixed 'Interval' every that many steps; otherwise once the
-    /// distance moved since the last adaptation reaches half the buffer
-    /// (buffer cells x finest cell size), so the interface cannot leave the
-    /// refined band in between.
-    bool due(double distance_moved);
+    /// Whether the refined cells follow the interface only (no Kelly
+    /// refinement of the velocity): then the interface's speed, not the
+    /// fastest fluid's, says when the band must move.
+    bool follows_interface_only() const { return settings.refine_fraction == 0.; }
+
+    /// epsilon of the interface band: cells with epsilon < phi < 1 - epsilon.
+    double interface_threshold() const { return settings.interface_threshold; }
+
+    /// Called once per step with the distance the interface moved (max |u|
+    /// dt over the cells it crosses; the fastest material point's with
+    /// Kelly refinement) and the mesh's levels: true when the mesh should be
+    /// adapted now. With a fixed 'Interval' every that many steps;
+    /// otherwise once the distance moved since the last adaptation reaches
+    /// 'Buffer fraction' of the buffer (buffer cells x finest cell size),
+    /// or once an interface cell comes within the margin, max(1,
+    /// floor((1 - fraction) x buffer cells)) face neighbours, of a cell
+    /// below the finest level: the band of phi between epsilon and
+    /// 1 - epsilon also widens by the transport's numerical diffusion,
+    /// which no material speed bounds.
+    bool due(double distance_moved, const MeshLevels &levels);
 
     /// Sets refine and coarsen flags (locally owned cells) for the state
     /// at `time` (the 'Region' expression may depend on t). True if any

@@ -171,6 +171,14 @@ namespace Suspension::Solid
 
     SolidDiagnostics diagnostics() const;
 
+    /// The largest |u| over the cells the interface crosses (nodal phi
+    /// between epsilon and 1 - epsilon) and their face neighbours, at both
+    /// ends of the last advance(): how fast the interface moved.
+    double interface_speed(double epsilon) const
+    {
+      return transport.interface_speed(solution, u0, u1, epsilon);
+    }
+
     /// How the initial phi was made (exact cell fractions: cut cells).
     const InitialFractionReport &initial_fraction_report() const { return initial_report; }
 

@@ -49,11 +49,10 @@ namespace Suspension::Solid::internal
     return std::clamp(x, lower, upper);
   }
 
-  // The THINC profile r at x (a point of the cell, or of one of its faces
-  // given across a periodic boundary): p + w (H - p), p the DG value, w
-  // how much of the profile the transport sees.
+  // The argument a of the THINC profile r at x (a point of the cell, or of
+  // one of its faces given across a periodic boundary).
   template <int dim, typename Reconstruction>
-  double profile_phi(const Reconstruction &r, const Point<dim> &x, const double dg_value)
+  double profile_argument(const Reconstruction &r, const Point<dim> &x)
   {
     double argument = r.offset;
     // for the curved profile: s = (x - centre) / h, n from the slope
@@ -72,6 +71,16 @@ namespace Suspension::Solid::internal
       }
     if (r.curvature != 0.)
       argument += r.curvature * (s2 - sn * sn / nn);
+    return argument;
+  }
+
+  // The THINC profile r at x: p + w (H - p), H = 1/2 (1 + tanh a) with a
+  // = profile_argument(r, x), p the DG value, w how much of the profile the
+  // transport sees.
+  template <int dim, typename Reconstruction>
+  double profile_phi(const Reconstruction &r, const Point<dim> &x, const double dg_value)
+  {
+    const double argument = profile_argument(r, x);
     // 1/2 (1 + tanh a) = 1 / (1 + exp(-2a)): one exp, cheaper than
     // glibc's tanh (which goes through expm1)
     return dg_value + r.weight * (1. / (1. + std::exp(-2. * argument)) - dg_value);

@@ -147,6 +147,14 @@ namespace Suspension::Solid
     /// it is called, every cell is marked.
     void mark_solid_cells(const VectorType &solution);
 
+    /// The largest |u| (u0 and u1: ghosted velocity vectors, at the
+    /// quadrature points) over the cells the interface crosses (nodal
+    /// values of phi above `epsilon` and below 1 - `epsilon`) and their
+    /// face neighbours: how fast the interface moves, which sets how often
+    /// the mesh that follows it must adapt.
+    double interface_speed(const VectorType &solution, const VectorType &u0,
+                           const VectorType &u1, double epsilon) const;
+
     /// Interface compression: phi also moves with the flux
     /// c |u| phi (1 - phi) grad phi / |grad phi| (towards the solid, only
     /// where 0 < phi < 1), with a Lax-Friedrichs face flux; 0: off.
@@ -207,6 +215,8 @@ namespace Suspension::Solid
 
       /// phi of this profile at x: p + w (H - p), p = `dg_value`
       double value(const Point<dim> &x, double dg_value) const;
+      /// the argument a of H = 1/2 (1 + tanh a) at x
+      double argument(const Point<dim> &x) const;
     };
 
     /// The profile of the locally owned cell with this active_cell_index(),
@@ -225,6 +235,12 @@ namespace Suspension::Solid
 
   private:
     using Lanes = std::array<Reconstruction, VectorizedArray<double>::size()>;
+
+    /// 1 for the cells (owned and ghost, by active_cell_index()) whose
+    /// lowest and highest nodal values of phi satisfy holds_at(lowest,
+    /// highest), and for their face neighbours; the same on every rank
+    template <typename Holds>
+    std::vector<unsigned char> cells_near(const VectorType &solution, const Holds &holds_at) const;
 
     /// fills `reconstruction` for the cells (and ghost cells) from src
     void compute_reconstruction(const VectorType &src) const;
