@@ -272,7 +272,7 @@ namespace Suspension
     // the interface band widened by the margin (due()) reaching a cell
     // below the finest level
     bool near_coarse = false;
-    if (solid && settings.enabled)
+    if (solid && settings.enabled && follows_interface_only())
       {
         const unsigned int margin = std::max(
           1, static_cast<int>(std::floor((1. - settings.buffer_fraction) * settings.buffer_cells)));

@@ -56,10 +56,13 @@ namespace Suspension
     /// smallest cell now, on an adaptive one that of the maximum level.
     double finest_cell_size() const;
 
-    /// Whether the refined cells follow the interface only (no Kelly
-    /// refinement of the velocity): then the interface's speed, not the
-    /// fastest fluid's, says when the band must move.
-    bool follows_interface_only() const { return settings.refine_fraction == 0.; }
+    /// Whether the interface's speed, not the fastest fluid's, says when
+    /// the band must move ('Adaptation speed = interface', no Kelly
+    /// refinement of the velocity).
+    bool follows_interface_only() const
+    {
+      return settings.interface_speed && settings.refine_fraction == 0.;
+    }
 
     /// epsilon of the interface band: cells with epsilon < phi < 1 - epsilon.
     double interface_threshold() const { return settings.interface_threshold; }
@@ -70,7 +73,8 @@ namespace Suspension
     /// adapted now. With a fixed 'Interval' every that many steps;
     /// otherwise once the distance moved since the last adaptation reaches
     /// 'Buffer fraction' of the buffer (buffer cells x finest cell size),
-    /// or once an interface cell comes within the margin, max(1,
+    /// or, with follows_interface_only(), once an interface cell comes
+    /// within the margin, max(1,
     /// floor((1 - fraction) x buffer cells)) face neighbours, of a cell
     /// below the finest level: the band of phi between epsilon and
     /// 1 - epsilon also widens by the transport's numerical diffusion,

@@ -39,6 +39,7 @@ namespace Suspension::Parameters
     unsigned int region_level        = 0;
     unsigned int interval            = 0;    // steps; 0: from the CFL number
     double       buffer_fraction     = 0.5;  // of the buffer crossed, Interval 0
+    bool         interface_speed     = false; // time adaptations by the interface's speed
     unsigned int initial_cycles      = 0;    // 0: maximum - global + 2
 
     static void declare(ParameterHandler &prm);
