@@ -159,6 +159,16 @@ namespace Suspension::Parameters
                       std::to_string(d.maximum_time_step),
                       Patterns::Double(1e-300, Patterns::Double::max_double_value),
                       "Upper bound of the adaptive time step.");
+    prm.declare_entry("Transport sub-step cost",
+                      "0",
+                      Patterns::Double(0., 100.),
+                      "Cost of one transport sub-step of phi and B over the "
+                      "cost of one fluid step (with its statistics). If "
+                      "positive, an adaptive time step of r times the "
+                      "transport's largest sub-step is cut to n = floor(r) "
+                      "sub-steps when that is cheaper per unit time, i.e. "
+                      "when r - n < n c (n + 1 - r) with c this value "
+                      "(doc/performance.md). 0: off.");
     prm.declare_entry("Steady state tolerance",
                       "0",
                       Patterns::Double(0., 1.),
@@ -179,6 +189,7 @@ namespace Suspension::Parameters
     adaptive          = prm.get_bool("Adaptive time step");
     cfl               = prm.get_double("CFL number");
     maximum_time_step = prm.get_double("Maximum time step");
+    substep_cost      = prm.get_double("Transport sub-step cost");
     steady_tolerance  = prm.get_double("Steady state tolerance");
     maximum_steps     = prm.get_integer("Maximum number of steps");
     prm.leave_subsection();

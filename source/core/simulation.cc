@@ -205,6 +205,8 @@ namespace Suspension
         if (next > elastic)
           next = 0.9 * elastic;
       }
+    if (ts.adaptive && solid && ts.substep_cost > 0.)
+      next = fit_to_transport_substeps(next, d.max_speed_over_h);
     // A collapsing step means the flow blew up without (yet) a NaN.
     if (next < 1e-6 * ts.time_step)
       {
@@ -222,6 +224,26 @@ namespace Suspension
       if (target > time + 1e-12 * next && target < time + next * (1. + 1e-3))
         return target - time;
     return next;
+  }
+
+  template <int dim>
+  double Simulation<dim>::fit_to_transport_substeps(const double dt,
+                                                    const double speed_over_h) const
+  {
+    // A step of r transport limits tau costs F + ceil(r) T; one of
+    // n = floor(r) limits costs F + n T for n tau of time. Per unit time
+    // the shorter one is cheaper when (r - n) F < n T (n + 1 - r).
+    const double tau = solid->max_substep(speed_over_h);
+    const double r   = dt / tau;
+    const double n   = std::floor(r);
+    if (n < 1. || r - n < 1e-9 * r)
+      return dt;
+    const double c = parameters.time_stepping.substep_cost;
+    if (r - n >= n * c * (n + 1. - r))
+      return dt;
+    // 1 % below n tau: the step then stays put (the CFL hysteresis) while
+    // the speed rises by up to 1 %, instead of changing every step
+    return 0.99 * n * tau;
   }
 
   template <int dim>
@@ -323,7 +345,9 @@ namespace Suspension
         TimerOutput::Scope scope(timer, "solid transport");
         solid_diagnostics = solid->advance(dt, flow_diagnostics.max_speed_over_h, fluid.velocity(),
                                            fluid.extrapolated_velocity(dt));
+        transport_substeps_run += solid_diagnostics.substeps;
       }
+    ++steps_run;
     update_contact_force();
     return fluid.advance(dt, sources);
   }

@@ -193,6 +193,9 @@ namespace Suspension
       mesh_report->report(pcout.get_stream(), triangulation.n_global_active_cells());
     if (solid_report)
       solid_report->report(pcout, solid_diagnostics, fluid.velocity(), fluid.time());
+    if (solid && parameters.time_stepping.substep_cost > 0.)
+      pcout << "  time step fitted to the transport: " << steps_run << " steps, "
+            << transport_substeps_run << " transport sub-steps in this run" << std::endl;
     if (contact_report && pcout.is_active())
       contact_report->report(pcout.get_stream());
     verification_report.report_errors(pcout, fluid.velocity(), fluid.kinematic_pressure(),

@@ -41,6 +41,9 @@ namespace Suspension::Parameters
     bool         adaptive           = false;
     double       cfl                = 0.5;
     double       maximum_time_step  = 1.;
+    /// cost of a transport sub-step over that of a fluid step (0: the
+    /// step is not fitted to the sub-steps)
+    double       substep_cost       = 0.;
     double       steady_tolerance   = 0.;
     unsigned int maximum_steps      = 0;
 

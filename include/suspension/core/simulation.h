@@ -109,6 +109,9 @@ namespace Suspension
     bool   adapt_mesh();
     void   change_mesh_with_fields();
     double choose_time_step(double dt, double time, const Fluid::FlowDiagnostics &d) const;
+    /// dt cut to a whole number of transport sub-steps when that is cheaper
+    /// ('Time stepping/Transport sub-step cost')
+    double fit_to_transport_substeps(double dt, double speed_over_h) const;
     bool   output_due(double time, double dt) const;
     void   write_output();
     void   add_statistics_row(const Fluid::StepReport &r, const Fluid::FlowDiagnostics &d,
@@ -149,6 +152,8 @@ namespace Suspension
     double                                    last_driving_force = 0.;
     bool                                      statistics_row     = true; // this step adds a row
     unsigned int                              n_outputs          = 0;
+    /// steps and transport sub-steps of this run (since its start or resume)
+    unsigned long                             steps_run = 0, transport_substeps_run = 0;
     Checkpoint<dim>                           checkpoint;
     double wall_time_before = 0.; // of the run up to the checkpoint it resumed from
     /// the step loop's state
