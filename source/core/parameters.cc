@@ -165,9 +165,10 @@ namespace Suspension::Parameters
                       "Cost of one transport sub-step of phi and B over the "
                       "cost of one fluid step (with its statistics). If "
                       "positive, an adaptive time step of r times the "
-                      "transport's largest sub-step is cut to n = floor(r) "
-                      "sub-steps when that is cheaper per unit time, i.e. "
-                      "when r - n < n c (n + 1 - r) with c this value "
+                      "transport's largest sub-step tau (ceil(r) sub-steps) "
+                      "is cut to 0.99 n tau, n = floor(r) sub-steps, when "
+                      "that is cheaper per unit time: r (1 + n c) < "
+                      "0.99 n (1 + ceil(r) c), c this value "
                       "(doc/performance.md). 0: off.");
     prm.declare_entry("Steady state tolerance",
                       "0",

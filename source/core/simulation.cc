@@ -230,20 +230,22 @@ namespace Suspension
   double Simulation<dim>::fit_to_transport_substeps(const double dt,
                                                     const double speed_over_h) const
   {
-    // A step of r transport limits tau costs F + ceil(r) T; one of
-    // n = floor(r) limits costs F + n T for n tau of time. Per unit time
-    // the shorter one is cheaper when (r - n) F < n T (n + 1 - r).
+    // A step of r transport limits tau costs F + ceil(r) T for r tau of
+    // time; the shorter one, s = 0.99 n tau with n = floor(r), costs
+    // F + n T for s. Per unit time (c = T / F) the shorter one is cheaper
+    // when r (1 + n c) < 0.99 n (1 + ceil(r) c). It is 1 % below n tau so
+    // that the CFL hysteresis keeps it while the speed rises by up to 1 %.
+    // Comparing with s itself, not with n tau, means that a step cut once
+    // is never cut again for the same speed (r = 0.99 n fails the test).
     const double tau = solid->max_substep(speed_over_h);
     const double r   = dt / tau;
     const double n   = std::floor(r);
     if (n < 1. || r - n < 1e-9 * r)
       return dt;
     const double c = parameters.time_stepping.substep_cost;
-    if (r - n >= n * c * (n + 1. - r))
-      return dt;
-    // 1 % below n tau: the step then stays put (the CFL hysteresis) while
-    // the speed rises by up to 1 %, instead of changing every step
-    return 0.99 * n * tau;
+    if (r * (1. + n * c) < 0.99 * n * (1. + (n + 1.) * c))
+      return 0.99 * n * tau;
+    return dt;
   }
 
   template <int dim>
@@ -337,7 +339,9 @@ namespace Suspension
             TimerOutput::Scope scope(timer, "solid transport");
             solid_diagnostics =
               solid->advance(dt, flow_diagnostics.max_speed_over_h, u_begin, fluid.velocity());
+            transport_substeps_run += solid_diagnostics.substeps;
           }
+        ++steps_run;
         return Fluid::StepReport();
       }
     if (solid)

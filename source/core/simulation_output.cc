@@ -195,7 +195,7 @@ namespace Suspension
       solid_report->report(pcout, solid_diagnostics, fluid.velocity(), fluid.time());
     if (solid && parameters.time_stepping.substep_cost > 0.)
       pcout << "  time step fitted to the transport: " << steps_run << " steps, "
-            << transport_substeps_run << " transport sub-steps in this run" << std::endl;
+            << transport_substeps_run << " transport sub-steps since the start (or resume)" << std::endl;
     if (contact_report && pcout.is_active())
       contact_report->report(pcout.get_stream());
     verification_report.report_errors(pcout, fluid.velocity(), fluid.kinematic_pressure(),
