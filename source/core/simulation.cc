@@ -339,9 +339,7 @@ namespace Suspension
             TimerOutput::Scope scope(timer, "solid transport");
             solid_diagnostics =
               solid->advance(dt, flow_diagnostics.max_speed_over_h, u_begin, fluid.velocity());
-            transport_substeps_run += solid_diagnostics.substeps;
           }
-        ++steps_run;
         return Fluid::StepReport();
       }
     if (solid)
@@ -349,9 +347,7 @@ namespace Suspension
         TimerOutput::Scope scope(timer, "solid transport");
         solid_diagnostics = solid->advance(dt, flow_diagnostics.max_speed_over_h, fluid.velocity(),
                                            fluid.extrapolated_velocity(dt));
-        transport_substeps_run += solid_diagnostics.substeps;
       }
-    ++steps_run;
     update_contact_force();
     return fluid.advance(dt, sources);
   }
@@ -375,6 +371,9 @@ namespace Suspension
   void Simulation<dim>::record_step(const Fluid::StepReport &report, const double dt,
                                     const double wall_time)
   {
+    ++steps_run;
+    if (solid)
+      transport_substeps_run += solid_diagnostics.substeps;
     // a row every 'Output/Statistics interval' steps, and at the first
     statistics_row = (fluid.step_number() - 1) % parameters.output.statistics_interval == 0;
     if (statistics_row)
