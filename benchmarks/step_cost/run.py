@@ -5,6 +5,7 @@
 Usage (from the repository root):
 
     python3 benchmarks/step_cost/run.py [--old REV] [--scenes a,b,...] [--replot]
+                                        [--old-scenes-only]
 
 Builds REV (default: 958feed, the end of session 10, before issue 14's
 work) in a git worktree under work/old, copies build/suspension (the
@@ -13,6 +14,9 @@ one after the other, never two at once. Prints per scene the wall time,
 the TimerOutput sections that matter, the peak resident memory and the
 ratios new/old, and writes results.csv and step_cost.png next to this
 script. --replot redraws the chart and reprints the table from results.csv.
+--old-scenes-only runs REV's scene files with the present binary instead of
+building REV: the comparison of a scene's new settings where the code of
+the old ones is unchanged.
 """
 
 import argparse
@@ -65,11 +69,12 @@ def sh(cmd, **kw):
     return subprocess.run(cmd, check=True, **kw)
 
 
-def build_old(rev):
-    """A worktree of `rev` with its own Release build (about 5 minutes)."""
+def build_old(rev, build=True):
+    """A worktree of `rev` with its own Release build (about 5 minutes);
+    with build=False only the worktree (its scene files)."""
     tree = os.path.join(WORK, "old")
     exe = os.path.join(tree, "build", "suspension")
-    if os.path.exists(exe):
+    if os.path.exists(exe if build else tree):
         have = subprocess.run(["git", "-C", tree, "rev-parse", "HEAD"], capture_output=True,
                               text=True).stdout.strip()
         want = subprocess.run(["git", "-C", REPO, "rev-parse", rev], capture_output=True,
@@ -79,6 +84,8 @@ def build_old(rev):
     if os.path.exists(tree):
         sh(["git", "-C", REPO, "worktree", "remove", "--force", tree])
     sh(["git", "-C", REPO, "worktree", "add", "--detach", tree, rev])
+    if not build:
+        return exe
     sh(["cmake", "-S", tree, "-B", os.path.join(tree, "build"), "-DCMAKE_BUILD_TYPE=Release"],
        stdout=subprocess.DEVNULL)
     sh(["cmake", "--build", os.path.join(tree, "build"), "-j", str(os.cpu_count() or 1)],
@@ -185,6 +192,9 @@ def main():
     parser.add_argument("--old", default="958feed")
     parser.add_argument("--scenes", default="")
     parser.add_argument("--replot", action="store_true")
+    parser.add_argument("--old-scenes-only", action="store_true",
+                        help="run REV's scene files with the present binary (no build): for a "
+                             "change of a scene's settings whose code path REV already had")
     parser.add_argument("--csv", default="results.csv",
                         help="the table's file in benchmarks/step_cost/ (a subset of the scenes "
                              "can keep its own)")
@@ -194,7 +204,9 @@ def main():
         rows = list(csv.DictReader(open(csv_path)))
     else:
         os.makedirs(WORK, exist_ok=True)
-        exes = {"old": build_old(a.old), "new": copy_new()}
+        new = copy_new()
+        old = build_old(a.old, build=not a.old_scenes_only)
+        exes = {"old": new if a.old_scenes_only else old, "new": new}
         trees = {"old": os.path.join(WORK, "old"), "new": REPO}
         chosen = [s for s in SCENES if not a.scenes or any(k in s for k in a.scenes.split(","))]
         rows = []

@@ -300,6 +300,12 @@ namespace Suspension::Parameters
       check_particles(dim);
     check_probes(dim);
     resolve_contact_force();
+    if (fluid_solver.convection == ConvectionForm::semi_implicit && solid.semi_implicit &&
+        solid.elastic())
+      throw InputError("Fluid solver/Convection",
+                       "semi-implicit convection is not combined with 'Solid/Elastic "
+                       "coupling = semi-implicit' (its assembled step matrix has no "
+                       "convective part)");
     if (flow_driving.type != FlowDrivingType::none &&
         boundary_conditions.type[0] != BoundaryType::periodic)
       throw InputError("Flow driving/Type",

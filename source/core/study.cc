@@ -284,12 +284,27 @@ namespace Suspension
     if (with_pressure)
       pcout << ", final pressure rate: " << pressure_rate;
     pcout << std::defaultfloat << std::endl;
+    // The last rate alone is not a verdict: a run that blows up at every
+    // cycle can still give a large "rate" between two overflowing errors.
+    // Every cycle's final error must also be finite and below the previous.
+    const auto falls = [&](const auto error_of) {
+      for (unsigned int k = 0; k < runs.size(); ++k)
+        if (!std::isfinite(error_of(runs[k].final_errors)) ||
+            (k > 0 && !(error_of(runs[k].final_errors) < error_of(runs[k - 1].final_errors))))
+          return false;
+      return true;
+    };
+    const bool velocity_falls = falls([](const auto &e) { return e.velocity_l2; });
+    const bool pressure_falls = falls([](const auto &e) { return e.pressure_l2; });
     if (v.minimum_velocity_rate > 0)
       pcout << "velocity rate >= " << v.minimum_velocity_rate << ": "
-            << (velocity_rate >= v.minimum_velocity_rate ? "yes" : "no") << std::endl;
+            << (velocity_falls && velocity_rate >= v.minimum_velocity_rate ? "yes" : "no")
+            << std::endl;
     if (v.minimum_pressure_rate > 0)
       pcout << "pressure rate >= " << v.minimum_pressure_rate << ": "
-            << (with_pressure && pressure_rate >= v.minimum_pressure_rate ? "yes" : "no")
+            << (with_pressure && pressure_falls && pressure_rate >= v.minimum_pressure_rate ?
+                  "yes" :
+                  "no")
             << std::endl;
   }
 

@@ -146,10 +146,19 @@ namespace Suspension::Parameters
                       "2006) or standard (p += psi).");
     prm.declare_entry("Convection",
                       "skew-symmetric",
-                      Patterns::Selection("skew-symmetric|none"),
-                      "Convective term, extrapolated explicitly to second "
-                      "order: skew-symmetric (u.grad u + div(u) u / 2) or "
-                      "none (unsteady Stokes).");
+                      Patterns::Selection("skew-symmetric|semi-implicit|none"),
+                      "Convective term, in the skew-symmetric form "
+                      "u.grad u + div(u) u / 2: skew-symmetric (explicit, "
+                      "u* = the velocity extrapolated to second order in "
+                      "both places; stable to a CFL number of about 0.4 "
+                      "with Q2), semi-implicit (u*.grad u + div(u*) u / 2 "
+                      "with the new u in the momentum operator, solved "
+                      "with GMRES: no CFL limit of its own (one on dt "
+                      "times the velocity gradient remains), for 'CFL "
+                      "number' up to 1 and beyond; needs 'Momentum "
+                      "operator = matrix-free' and 'Solid/Elastic coupling "
+                      "= explicit'; doc/method.md) or none (unsteady "
+                      "Stokes).");
     prm.declare_entry("Linear solver tolerance",
                       "1e-10",
                       Patterns::Double(1e-16, 1e-2),
@@ -188,15 +197,19 @@ namespace Suspension::Parameters
     projection       = prm.get("Projection form") == "rotational" ?
                          ProjectionForm::rotational :
                          ProjectionForm::standard;
-    convection       = prm.get("Convection") == "none" ?
-                         ConvectionForm::none :
-                         ConvectionForm::skew_symmetric;
+    convection       = prm.get("Convection") == "none"           ? ConvectionForm::none :
+                       prm.get("Convection") == "semi-implicit" ? ConvectionForm::semi_implicit :
+                                                                  ConvectionForm::skew_symmetric;
     solver_tolerance = prm.get_double("Linear solver tolerance");
     jacobi_momentum  = prm.get("Momentum preconditioner") == "jacobi";
     matrix_free_momentum = prm.get("Momentum operator") == "matrix-free";
     prm.leave_subsection();
     if (mode == VelocityMode::prescribed)
       check_expression("Fluid solver/Prescribed velocity", prescribed_velocity, dim, dim);
+    if (convection == ConvectionForm::semi_implicit && !matrix_free_momentum)
+      throw InputError("Fluid solver/Convection",
+                       "semi-implicit convection needs 'Fluid solver/Momentum "
+                       "operator = matrix-free'");
     if (pressure_degree >= velocity_degree)
       throw InputError("Fluid solver/Pressure degree",
                        "must be lower than the velocity degree (" +

@@ -2,6 +2,7 @@
 #include <deal.II/fe/mapping_q1.h>
 #include <deal.II/lac/solver_cg.h>
 #include <deal.II/lac/solver_control.h>
+#include <deal.II/lac/solver_gmres.h>
 #include <deal.II/matrix_free/fe_evaluation.h>
 #include <deal.II/matrix_free/tools.h>
 
@@ -77,6 +78,7 @@ namespace Suspension::Fluid
       if (space.velocity_constraints.is_constrained(owned.nth_index_in_set(i)))
         constrained.push_back(i);
     mass = viscosity = -1.;
+    clear_advection();
     if (degree == 2)
       {
         compute_diagonal<2, 3>(mass_diagonal, 1., 0.);
@@ -103,15 +105,72 @@ namespace Suspension::Fluid
           {
             u.reinit(cell);
             u.gather_evaluate(in, EvaluationFlags::values | EvaluationFlags::gradients);
-            for (const unsigned int q : u.quadrature_point_indices())
-              {
-                u.submit_value(mass * u.get_value(q), q);
-                u.submit_gradient(viscosity * u.get_gradient(q), q);
-              }
+            if (advection_values.empty())
+              for (const unsigned int q : u.quadrature_point_indices())
+                {
+                  u.submit_value(mass * u.get_value(q), q);
+                  u.submit_gradient(viscosity * u.get_gradient(q), q);
+                }
+            else
+              for (const unsigned int q : u.quadrature_point_indices())
+                {
+                  const unsigned int k     = cell * u.n_q_points + q;
+                  const auto         value = u.get_value(q);
+                  const auto         grad  = u.get_gradient(q);
+                  u.submit_value((mass + advection_half_divergence[k]) * value +
+                                   grad * advection_values[k],
+                                 q);
+                  u.submit_gradient(viscosity * grad, q);
+                }
             u.integrate_scatter(EvaluationFlags::values | EvaluationFlags::gradients, out);
           }
       },
       dst, src, true);
+  }
+
+  template <int dim>
+  template <int fe_degree, int n_q>
+  void MomentumOperator<dim>::evaluate_advection(const Vector &u_star)
+  {
+    FEEvaluation<dim, fe_degree, n_q, dim, double> w(matrix_free);
+    const unsigned int n_batches = matrix_free.n_cell_batches();
+    n_advection_points = w.n_q_points;
+    advection_values.resize(std::size_t(n_batches) * w.n_q_points);
+    advection_half_divergence.resize(std::size_t(n_batches) * w.n_q_points);
+    for (unsigned int cell = 0; cell < n_batches; ++cell)
+      {
+        w.reinit(cell);
+        // as stored, boundary values included (as the explicit right-hand
+        // side reads it)
+        w.read_dof_values_plain(u_star);
+        w.evaluate(EvaluationFlags::values | EvaluationFlags::gradients);
+        for (const unsigned int q : w.quadrature_point_indices())
+          {
+            const unsigned int k         = cell * w.n_q_points + q;
+            advection_values[k]          = w.get_value(q);
+            advection_half_divergence[k] = 0.5 * w.get_divergence(q);
+          }
+      }
+  }
+
+  template <int dim>
+  void MomentumOperator<dim>::set_advection(const Combination &terms)
+  {
+    // x_local is free between solves; the caller's solve overwrites it
+    form_locally_owned(terms, x_local);
+    x_local.update_ghost_values();
+    if (degree == 2)
+      evaluate_advection<2, 3>(x_local);
+    else
+      evaluate_advection<-1, 0>(x_local);
+    x_local.zero_out_ghost_values();
+  }
+
+  template <int dim>
+  void MomentumOperator<dim>::clear_advection()
+  {
+    advection_values.clear();
+    advection_half_divergence.clear();
   }
 
   template <int dim>
@@ -188,7 +247,8 @@ namespace Suspension::Fluid
   std::size_t MomentumOperator<dim>::vector_memory() const
   {
     return mass_diagonal.memory_consumption() + viscous_diagonal.memory_consumption() +
-           x_local.memory_consumption() + b_local.memory_consumption();
+           x_local.memory_consumption() + b_local.memory_consumption() +
+           advection_values.memory_consumption() + advection_half_divergence.memory_consumption();
   }
 
   template <int dim>
@@ -206,9 +266,19 @@ namespace Suspension::Fluid
       x_local = 0.;
     else
       {
-        SolverControl    control(5000, tolerance * norm);
-        SolverCG<Vector> cg(control);
-        cg.solve(*this, x_local, b_local, InverseDiagonal{this});
+        SolverControl control(5000, tolerance * norm);
+        if (advection_values.empty())
+          {
+            SolverCG<Vector> cg(control);
+            cg.solve(*this, x_local, b_local, InverseDiagonal{this});
+          }
+        else
+          {
+            // right preconditioning: the residual tested is b - A x, as CG's
+            typename SolverGMRES<Vector>::AdditionalData data(50, true);
+            SolverGMRES<Vector> gmres(control, data);
+            gmres.solve(*this, x_local, b_local, InverseDiagonal{this});
+          }
         iterations = control.last_step();
       }
     copy_locally_owned(x_local, x);

@@ -153,6 +153,10 @@ namespace Suspension::Fluid
                 {
                   value -= load.alpha_over_dt * lift.get_value(q);
                   gradient -= load.viscosity * lift.get_gradient(q);
+                  // semi-implicit convection: the operator's C(u*) g too
+                  if (op.advecting())
+                    value -= lift.get_gradient(q) * op.advection_value(cell, q) +
+                             op.advection_half_div(cell, q) * lift.get_value(q);
                 }
               if (cell_stress)
                 for (unsigned int v = 0; v < n_lanes; ++v)

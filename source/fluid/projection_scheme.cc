@@ -73,9 +73,10 @@ namespace Suspension::Fluid
     u_older = u;
     velocity_ghosted = u;
     pressure_ghosted = p;
-    current_time = 0.;
-    last_dt      = 0.;
-    n_steps      = 0;
+    current_time  = 0.;
+    last_dt       = 0.;
+    n_steps       = 0;
+    driving_force = 0.;
   }
 
   template <int dim>
@@ -159,7 +160,7 @@ namespace Suspension::Fluid
   void ProjectionScheme<dim>::save(std::ostream &out) const
   {
     out << "ProjectionScheme " << std::setprecision(17) << current_time << " " << last_dt << " "
-        << n_steps << " " << last_change_rate << "\n";
+        << n_steps << " " << last_change_rate << " " << driving_force << "\n";
   }
 
   template <int dim>
@@ -169,6 +170,10 @@ namespace Suspension::Fluid
     in >> tag >> current_time >> last_dt >> n_steps >> last_change_rate;
     AssertThrow(tag == "ProjectionScheme" && !in.fail(),
                 ExcMessage("checkpoint: cannot read the fluid's time levels"));
+    // checkpoints written before session 30 end here; the force is then
+    // found again in full by the first step
+    if (!(in >> driving_force))
+      driving_force = 0.;
   }
 
   template <int dim>
@@ -326,6 +331,18 @@ namespace Suspension::Fluid
     if (n_steps > 0)
       load.p_sharp.insert(load.p_sharp.end(), {{4. / 3., &psi}, {-1. / 3., &psi_old}});
 
+    // With semi-implicit convection the force of the last step (or the
+    // imposed gradient) joins the load; otherwise all of it comes from the
+    // flow-rate control below.
+    const bool implicit_convection =
+      parameters.fluid_solver.convection == Parameters::ConvectionForm::semi_implicit;
+    double imposed_force = 0.;
+    if (implicit_convection)
+      imposed_force =
+        parameters.flow_driving.type == Parameters::FlowDrivingType::constant_pressure_gradient ?
+          parameters.flow_driving.pressure_gradient :
+          driving_force;
+
     // 1. momentum predictor
     // Boundary data only need rebuilding when a face carries a (possibly
     // time-dependent) non-zero velocity; otherwise the homogeneous
@@ -333,6 +350,10 @@ namespace Suspension::Fluid
     scene.set_time(t_new);
     if (scene.has_inhomogeneous_velocity())
       make_step_constraints();
+    // semi-implicit convection: u* at the quadrature points first, the
+    // lifting of boundary data in the right-hand side needs it too
+    if (implicit_convection)
+      operators.momentum_operator.set_advection(load.u_star);
     assemble_momentum_rhs(load, dt, t_new, sources);
     const double tolerance = parameters.fluid_solver.solver_tolerance;
     if (operators.step_matrix)
@@ -352,23 +373,33 @@ namespace Suspension::Fluid
     else
       {
         section.next("fluid: momentum solve");
+        if (implicit_convection && driven)
+          rhs_u.add(imposed_force / parameters.material.density, operators.unit_force);
         report.momentum_iterations = operators.solve_momentum(u, rhs_u, tolerance);
       }
+    operators.momentum_operator.clear_advection();
     constraints_of_step().distribute(u);
 
-    // 2. flow-rate control by linearity
+    // 2. flow-rate control by linearity: u + f w, w the response to a
+    // unit force. With semi-implicit convection the operator of u is not
+    // the one of w (A without convection, kept while dt is): the load
+    // then holds the last step's force and w carries only its change, so
+    // that the mismatch, change times (u*.grad) w, is of second order.
     const auto &driving = parameters.flow_driving;
     if (driving.type == Parameters::FlowDrivingType::constant_flow_rate)
       {
         const double target = driving.bulk_velocity * scene.volume();
-        report.driving_force = (target - flux(u)) / flux(unit_response);
-        u.add(report.driving_force, unit_response);
+        const double change = (target - flux(u)) / flux(unit_response);
+        report.driving_force = imposed_force + change;
+        u.add(change, unit_response);
       }
     else if (driving.type == Parameters::FlowDrivingType::constant_pressure_gradient)
       {
         report.driving_force = driving.pressure_gradient;
-        u.add(report.driving_force, unit_response);
+        if (!implicit_convection)
+          u.add(report.driving_force, unit_response);
       }
+    driving_force = report.driving_force;
 
     // 3. projection: the increment psi
     section.next("fluid: projection");
@@ -486,8 +517,9 @@ namespace Suspension::Fluid
     MomentumLoad<dim> &load, const double dt, const double t_new,
     const std::vector<const MomentumSource<dim> *> &sources)
   {
+    // (semi-implicit convection is the momentum operator's)
     const bool convection =
-      parameters.fluid_solver.convection != Parameters::ConvectionForm::none;
+      parameters.fluid_solver.convection == Parameters::ConvectionForm::skew_symmetric;
     bool any_stress = false;
     for (const auto *s : sources)
       any_stress = any_stress || s->has_stress();

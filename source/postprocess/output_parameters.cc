@@ -242,7 +242,8 @@ namespace Suspension::Parameters
                       Patterns::Double(0.),
                       "If positive, a study checks that the velocity L2 "
                       "error falls at least at this rate between its last "
-                      "two cycles and prints the verdict.");
+                      "two cycles, and from every cycle to the next (finite), "
+                      "and prints the verdict.");
     prm.declare_entry("Minimum pressure rate",
                       "0",
                       Patterns::Double(0.),

@@ -54,7 +54,8 @@ namespace Suspension::Parameters
 
   enum class ConvectionForm
   {
-    skew_symmetric,
+    skew_symmetric, // explicit, extrapolated to second order
+    semi_implicit,  // the extrapolated velocity advects the new one
     none
   };
 

@@ -58,13 +58,35 @@ namespace Suspension::Fluid
     /// them without any set-up.
     void set_coefficients(double mass, double viscosity);
 
+    /// Semi-implicit convection (issue 14, item 5): until
+    /// clear_advection(), the operator is A u + (u*.grad) u + div(u*) u / 2
+    /// with u* = `terms` (the extrapolated velocity), whose values and
+    /// half divergence are stored at the quadrature points here, and
+    /// solve() uses GMRES. The skew-symmetric form leaves the diagonal, and
+    /// so the Jacobi preconditioner, as it is: for a basis function v,
+    /// (u*.grad v, v) + (div(u*) v / 2, v) = (div(u* v^2), 1) / 2 = 0.
+    void set_advection(const Combination &terms);
+    void clear_advection();
+    bool advecting() const { return !advection_values.empty(); }
+    /// u* and div(u*) / 2 at point q of cell batch `cell` (while advecting)
+    const Tensor<1, dim, VectorizedArray<double>> &advection_value(const unsigned int cell,
+                                                                   const unsigned int q) const
+    {
+      return advection_values[std::size_t(cell) * n_advection_points + q];
+    }
+    const VectorizedArray<double> &advection_half_div(const unsigned int cell,
+                                                      const unsigned int q) const
+    {
+      return advection_half_divergence[std::size_t(cell) * n_advection_points + q];
+    }
+
     /// dst = A src on the unconstrained DoFs; constrained ones copied.
     void vmult(Vector &dst, const Vector &src) const;
 
     /// Solves A x = b to `tolerance` relative to |b| with the constrained
     /// entries of b and of the initial guess x set to zero (the caller
     /// distributes the constraints afterwards, as for the assembled A).
-    /// Returns the CG iterations.
+    /// Returns the CG (GMRES while advecting) iterations.
     unsigned int solve(VectorType &x, const VectorType &b, double tolerance) const;
 
     /// The two work vectors of a solve (velocity DoFs), free between
@@ -86,6 +108,8 @@ namespace Suspension::Fluid
   private:
     template <int degree, int n_q>
     void apply_cells(Vector &dst, const Vector &src) const;
+    template <int degree, int n_q>
+    void evaluate_advection(const Vector &u_star);
     /// diag(mass M + viscosity K) into `diagonal`
     template <int degree, int n_q>
     void compute_diagonal(Vector &diagonal, double mass, double viscosity) const;
@@ -105,5 +129,10 @@ namespace Suspension::Fluid
     Vector                  mass_diagonal, viscous_diagonal; // of M and K
     std::vector<unsigned int> constrained; // local indices, all constrained DoFs
     mutable Vector          x_local, b_local;
+    /// u* and div(u*) / 2 at the quadrature points of every cell batch
+    /// (index batch * points per cell + q); empty without advection
+    AlignedVector<Tensor<1, dim, VectorizedArray<double>>> advection_values;
+    AlignedVector<VectorizedArray<double>>                 advection_half_divergence;
+    unsigned int                                           n_advection_points = 0;
   };
 } // namespace Suspension::Fluid

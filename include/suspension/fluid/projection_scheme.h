@@ -174,6 +174,10 @@ namespace Suspension::Fluid
     unsigned int n_steps      = 0;
     double       alpha = 1., beta_1 = 1., beta_2 = 0.;
     double       last_change_rate = 0.;
+    /// the driving force of the last step: with semi-implicit convection
+    /// it is part of the next step's load, which then solves for its
+    /// change only (advance())
+    double       driving_force = 0.;
 
     using Transfer = parallel::distributed::SolutionTransfer<dim, VectorType>;
     std::unique_ptr<Transfer> velocity_transfer, pressure_transfer;
