@@ -9,6 +9,8 @@
 # for the same reason the linear iteration counts (its_*) may differ by one
 # and are left out, as are the wall times.
 # usage: check.sh SUSPENSION MPIEXEC THIS_DIRECTORY [RANKS [RESUME_RANKS]]
+# SET='Section/Entry=value' in the environment changes one entry of the
+# scene in all three runs.
 exe="$1"; mpiexec="$2"; dir="$3"; ranks="${4:-1}"; resume_ranks="${5:-$ranks}"
 K=${K:-12}; M=${M:-20} # checkpoint every K steps, stop after M
 work=$(mktemp -d); trap 'rm -rf "$work"' EXIT
@@ -21,13 +23,13 @@ run() { # RANKS ARGS...
 fail() { echo "FAILED: $*"; exit 1; }
 
 mkdir whole resumed
-(cd whole && run "$ranks" "$dir/scene.prm" > screen.txt 2>&1) ||
+(cd whole && run "$ranks" "$dir/scene.prm" ${SET:+--set "$SET"} > screen.txt 2>&1) ||
   { cat whole/screen.txt; fail "uninterrupted run"; }
-(cd resumed && run "$ranks" "$dir/scene.prm" --set "Checkpoint/Interval steps=$K" \
+(cd resumed && run "$ranks" "$dir/scene.prm" ${SET:+--set "$SET"} --set "Checkpoint/Interval steps=$K" \
    --set "Time stepping/Maximum number of steps=$M" > stopped.txt 2>&1) ||
   { cat resumed/stopped.txt; fail "run stopped after $M steps"; }
 grep "checkpoint at step" resumed/stopped.txt
-(cd resumed && run "$resume_ranks" "$dir/scene.prm" --resume > screen.txt 2>&1) ||
+(cd resumed && run "$resume_ranks" "$dir/scene.prm" ${SET:+--set "$SET"} --resume > screen.txt 2>&1) ||
   { cat resumed/screen.txt; fail "resumed run"; }
 grep "resumed from" resumed/screen.txt | sed "s|$work/||"
 
