@@ -351,7 +351,15 @@ namespace Suspension::Fluid
     if (scene.has_inhomogeneous_velocity())
       make_step_constraints();
     // semi-implicit convection: u* at the quadrature points first, the
-    // lifting of boundary data in the right-hand side needs it too
+    // lifting of boundary data in the right-hand side needs it too; the
+    // guard clears it at the end of the predictor, also when a solve
+    // throws (a later unit-response solve must not see a stale u*)
+    struct AdvectionGuard
+    {
+      MomentumOperator<dim> &op;
+      ~AdvectionGuard() { op.clear_advection(); }
+      void                   release() { op.clear_advection(); }
+    } advection_guard{operators.momentum_operator};
     if (implicit_convection)
       operators.momentum_operator.set_advection(load.u_star);
     assemble_momentum_rhs(load, dt, t_new, sources);
@@ -377,7 +385,7 @@ namespace Suspension::Fluid
           rhs_u.add(imposed_force / parameters.material.density, operators.unit_force);
         report.momentum_iterations = operators.solve_momentum(u, rhs_u, tolerance);
       }
-    operators.momentum_operator.clear_advection();
+    advection_guard.release();
     constraints_of_step().distribute(u);
 
     // 2. flow-rate control by linearity: u + f w, w the response to a
