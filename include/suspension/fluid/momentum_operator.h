@@ -16,7 +16,8 @@ namespace Suspension::Fluid
    * The momentum predictor's operator A = (alpha/dt) M + nu K without an
    * assembled matrix (issue 14, item 1): applied cell by cell with
    * FEEvaluation (sum factorisation), the hanging-node, periodic and
-   * Dirichlet constraints of the velocity resolved on the fly; CG with the
+   * Dirichlet constraints of the velocity resolved on the fly; CG (GMRES
+   * with semi-implicit convection, set_advection) with the
    * Jacobi preconditioner of its diagonal, computed matrix-free: the
    * diagonals of M and of K once per mesh, combined on the fly in every
    * application of the preconditioner, so that a change of dt costs
