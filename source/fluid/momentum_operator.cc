@@ -79,6 +79,8 @@ namespace Suspension::Fluid
         constrained.push_back(i);
     mass = viscosity = -1.;
     clear_advection();
+    advection_values.clear(); // sized for the old mesh
+    advection_half_divergence.clear();
     if (degree == 2)
       {
         compute_diagonal<2, 3>(mass_diagonal, 1., 0.);
@@ -105,7 +107,7 @@ namespace Suspension::Fluid
           {
             u.reinit(cell);
             u.gather_evaluate(in, EvaluationFlags::values | EvaluationFlags::gradients);
-            if (advection_values.empty())
+            if (!advection_active)
               for (const unsigned int q : u.quadrature_point_indices())
                 {
                   u.submit_value(mass * u.get_value(q), q);
@@ -164,13 +166,13 @@ namespace Suspension::Fluid
     else
       evaluate_advection<-1, 0>(x_local);
     x_local.zero_out_ghost_values();
+    advection_active = true;
   }
 
   template <int dim>
   void MomentumOperator<dim>::clear_advection()
   {
-    advection_values.clear();
-    advection_half_divergence.clear();
+    advection_active = false;
   }
 
   template <int dim>
@@ -267,7 +269,7 @@ namespace Suspension::Fluid
     else
       {
         SolverControl control(5000, tolerance * norm);
-        if (advection_values.empty())
+        if (!advection_active)
           {
             SolverCG<Vector> cg(control);
             cg.solve(*this, x_local, b_local, InverseDiagonal{this});

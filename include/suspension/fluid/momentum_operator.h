@@ -68,7 +68,7 @@ namespace Suspension::Fluid
     /// (u*.grad v, v) + (div(u*) v / 2, v) = (div(u* v^2), 1) / 2 = 0.
     void set_advection(const Combination &terms);
     void clear_advection();
-    bool advecting() const { return !advection_values.empty(); }
+    bool advecting() const { return advection_active; }
     /// u* and div(u*) / 2 at point q of cell batch `cell` (while advecting)
     const Tensor<1, dim, VectorizedArray<double>> &advection_value(const unsigned int cell,
                                                                    const unsigned int q) const
@@ -135,5 +135,8 @@ namespace Suspension::Fluid
     AlignedVector<Tensor<1, dim, VectorizedArray<double>>> advection_values;
     AlignedVector<VectorizedArray<double>>                 advection_half_divergence;
     unsigned int                                           n_advection_points = 0;
+    /// set between set_advection() and clear_advection(); the arrays are
+    /// kept (not reallocated every step) and freed only by reinit()
+    bool advection_active = false;
   };
 } // namespace Suspension::Fluid
