@@ -1,6 +1,6 @@
 #!/usr/bin/env python3
-"""SSP-RK3 against SSP-RK2 for the DG 1 transport of phi (and B): accuracy
-against cost, side by side in one run.
+"""SSP-RK3, SSP-RK2 and SSP-RK(3,2) for the DG 1 transport of phi (and B):
+accuracy against cost, side by side in one run.
 
 Usage (from the repository root, after a build in build/):
 
@@ -16,7 +16,7 @@ Scenes (the test suite's, so their references are documented there):
   shear    tests/solid_disc_shear_01.prm: the elastic disc in shear at three
            capillary numbers (largest relative deviation of D at t = 0.8
            from doc/solid_theory.md, as the test prints it).
-Each runs with 'Solid/Time integrator' = SSP-RK3 and = SSP-RK2, one MPI rank
+Each runs with 'Solid/Time integrator' = SSP-RK3, SSP-RK2 and SSP-RK(3,2), one MPI rank
 each, as many at a time as cores (JOBS=n). Seconds are the runs' own
 TimerOutput totals (wall time of one rank). Writes results.csv and transport_integrator.png.
 """
@@ -36,11 +36,12 @@ from benchmark_tools import plt, SUSPENSION, PARALLEL, work_directory, write_csv
 WORK = work_directory(HERE, False)
 SCENES = {"zalesak": "solid_zalesak_01.prm", "disc": "solid_rotating_disc_01.prm",
           "shear": "solid_disc_shear_01.prm"}
-INTEGRATORS = ["SSP-RK3", "SSP-RK2"]
+INTEGRATORS = ["SSP-RK3", "SSP-RK2", "SSP-RK(3,2)"]
+MARKERS = {"SSP-RK3": "o", "SSP-RK2": "s", "SSP-RK(3,2)": "^"}
 
 
 def run(scene, integrator):
-    out = os.path.join(WORK, f"{scene}_{integrator}")
+    out = os.path.join(WORK, f"{scene}_" + re.sub(r"[^A-Za-z0-9-]+", "", integrator))
     os.makedirs(out, exist_ok=True)
     cmd = [SUSPENSION, os.path.join(REPO, "tests", SCENES[scene]),
            "--set", f"Solid/Time integrator={integrator}", "--set", f"Output/Directory={out}",
@@ -108,8 +109,11 @@ def main():
               f"{str(r.get('error', '')):>10s} {str(r.get('error_means', '')):>10s} {str(r.get('D', '')):>8s}")
     for s in SCENES:
         a = [r for r in rows if r["scene"] == s]
-        if len(a) == 2:
-            print(f"{s}: RK2 / RK3 time {float(a[1]['seconds']) / float(a[0]['seconds']):.3f}")
+        rk3 = [r for r in a if r["integrator"] == "SSP-RK3"]
+        for r in a:
+            if rk3 and r is not rk3[0]:
+                print(f"{s}: {r['integrator']} / SSP-RK3 time "
+                      f"{float(r['seconds']) / float(rk3[0]['seconds']):.3f}")
 
     fig, axes = plt.subplots(1, 3, figsize=(13, 4))
     for ax, s, key, label in zip(axes, SCENES, ["error", "error", "error"],
@@ -117,13 +121,13 @@ def main():
                                   "largest |D / D_theory - 1|, t = 0.8"]):
         for r in rows:
             if r["scene"] == s and r.get(key, "") != "":
-                ax.plot(float(r["seconds"]), float(r[key]), "o" if r["integrator"] == "SSP-RK3" else "s",
+                ax.plot(float(r["seconds"]), float(r[key]), MARKERS.get(r["integrator"], "x"),
                         label=r["integrator"], ms=8)
         ax.set_xlabel("wall seconds, one rank")
         ax.set_ylabel(label)
         ax.set_title(s)
         ax.legend()
-    fig.suptitle("DG 1 transport: SSP-RK3 against SSP-RK2")
+    fig.suptitle("DG 1 transport: SSP-RK3, SSP-RK2 and SSP-RK(3,2)")
     fig.tight_layout()
     fig.savefig(os.path.join(HERE, "transport_integrator.png"), dpi=110)
 

@@ -134,8 +134,10 @@ namespace Suspension::Fluid
     flux_weights.reinit(space.owned_velocity, communicator);
     unit_force.reinit(space.owned_velocity, communicator);
 
+    // (velocity gradients only for the assembled M, K and D)
     FEValues<dim> fe_u(space.fe_velocity, space.quadrature,
-                       update_values | update_gradients | update_JxW_values);
+                       update_values | update_JxW_values |
+                         (matrix_free_momentum ? update_default : update_gradients));
     FEValues<dim> fe_p(space.fe_pressure, space.quadrature,
                        update_values | update_gradients | update_JxW_values);
     const unsigned int nu = space.fe_velocity.n_dofs_per_cell();
@@ -163,23 +165,22 @@ namespace Suspension::Fluid
                 {
                   const unsigned int ci = component[i];
                   const double       vi = fe_u.shape_value(i, q);
-                  const auto        &gi = fe_u.shape_grad(i, q);
-                  // (M and K only for the assembled momentum operator)
-                  if (!matrix_free_momentum)
-                    for (unsigned int j = 0; j < nu; ++j)
-                      if (component[j] == ci)
-                        {
-                          cell_M(i, j) += vi * fe_u.shape_value(j, q) * JxW;
-                          cell_K(i, j) += gi * fe_u.shape_grad(j, q) * JxW;
-                        }
                   if (ci == 0)
                     {
                       cell_flux(i) += vi * JxW;
                       cell_force(i) += vi * JxW;
                     }
-                  if (!matrix_free_momentum)
-                    for (unsigned int k = 0; k < np; ++k)
-                      cell_D(k, i) += fe_p.shape_value(k, q) * gi[ci] * JxW;
+                  if (matrix_free_momentum)
+                    continue;
+                  const auto &gi = fe_u.shape_grad(i, q);
+                  for (unsigned int j = 0; j < nu; ++j)
+                    if (component[j] == ci)
+                      {
+                        cell_M(i, j) += vi * fe_u.shape_value(j, q) * JxW;
+                        cell_K(i, j) += gi * fe_u.shape_grad(j, q) * JxW;
+                      }
+                  for (unsigned int k = 0; k < np; ++k)
+                    cell_D(k, i) += fe_p.shape_value(k, q) * gi[ci] * JxW;
                 }
               for (unsigned int k = 0; k < np; ++k)
                 for (unsigned int l = 0; l < np; ++l)

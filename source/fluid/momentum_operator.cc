@@ -191,38 +191,58 @@ namespace Suspension::Fluid
   void MomentumOperator<dim>::compute_diagonal(Vector &diagonal, const double mass,
                                               const double viscosity) const
   {
-    // The operator acts on each velocity component alike, so its diagonal
-    // is computed one component at a time with a scalar FEEvaluation: the
-    // unit vectors of one cell are then 27 scalar ones instead of 81
-    // three-component ones (in 3D, Q2), a third of the work (a ninth per
-    // column), with each component's own constraints. deal.II's
-    // compute_diagonal() selects the component in a vector of vectors only,
-    // so each component is summed into its own vector first.
-    matrix_free.initialize_dof_vector(diagonal);
-    std::vector<Vector> components(dim);
-    for (auto &v : components)
-      matrix_free.initialize_dof_vector(v);
+    // The operator acts on each velocity component alike, and the
+    // constraints that couple DoFs (hanging nodes, periodicity) do too, so
+    // its diagonal is computed for the first component with a scalar
+    // FEEvaluation and copied to the others: the unit vectors of one cell
+    // are then 27 scalar ones instead of 81 three-component ones (in 3D,
+    // Q2), and one component instead of dim. (A Dirichlet value of one
+    // component only, e.g. a slip wall, decouples nothing from the free
+    // DoFs; the constrained DoFs' entries are not used.)
+    // deal.II's compute_diagonal() selects the component in a vector of
+    // vectors only.
+    std::vector<Vector> components(1);
+    matrix_free.initialize_dof_vector(components[0]);
     // only the terms with a non-zero coefficient: the mass diagonal needs
     // no gradients, the viscous one no values
     const EvaluationFlags::EvaluationFlags flags =
       (mass != 0. ? EvaluationFlags::values : EvaluationFlags::nothing) |
       (viscosity != 0. ? EvaluationFlags::gradients : EvaluationFlags::nothing);
-    for (unsigned int c = 0; c < dim; ++c)
-      MatrixFreeTools::compute_diagonal<dim, fe_degree, n_q, 1, double, VectorizedArray<double>>(
-        matrix_free, components, [&](FEEvaluation<dim, fe_degree, n_q, 1, double> &u) {
-          u.evaluate(flags);
-          for (const unsigned int q : u.quadrature_point_indices())
+    MatrixFreeTools::compute_diagonal<dim, fe_degree, n_q, 1, double, VectorizedArray<double>>(
+      matrix_free, components, [&](FEEvaluation<dim, fe_degree, n_q, 1, double> &u) {
+        u.evaluate(flags);
+        for (const unsigned int q : u.quadrature_point_indices())
+          {
+            if (mass != 0.)
+              u.submit_value(mass * u.get_value(q), q);
+            if (viscosity != 0.)
+              u.submit_gradient(viscosity * u.get_gradient(q), q);
+          }
+        u.integrate(flags);
+      },
+      0, 0, 0);
+    diagonal.swap(components[0]);
+
+    // copy: on each locally owned cell, DoF (c, i) takes the value of
+    // (0, i); a support point's DoFs share one owner
+    const DoFHandler<dim>    &dof_handler = matrix_free.get_dof_handler(0);
+    const FiniteElement<dim> &fe          = dof_handler.get_fe();
+    const auto               &partitioner = *diagonal.get_partitioner();
+    std::vector<types::global_dof_index> dofs(fe.n_dofs_per_cell());
+    for (const auto &cell : dof_handler.active_cell_iterators())
+      if (cell->is_locally_owned())
+        {
+          cell->get_dof_indices(dofs);
+          for (unsigned int i = 0; i < fe.n_dofs_per_cell(); ++i)
             {
-              if (mass != 0.)
-                u.submit_value(mass * u.get_value(q), q);
-              if (viscosity != 0.)
-                u.submit_gradient(viscosity * u.get_gradient(q), q);
+              const auto [component, index] = fe.system_to_component_index(i);
+              if (component == 0 || !partitioner.in_local_range(dofs[i]))
+                continue;
+              const types::global_dof_index first = dofs[fe.component_to_system_index(0, index)];
+              diagonal.local_element(partitioner.global_to_local(dofs[i])) =
+                diagonal.local_element(partitioner.global_to_local(first));
             }
-          u.integrate(flags);
-        },
-        0, 0, c);
-    for (const auto &v : components)
-      diagonal += v;
+        }
   }
 
   template <int dim>

@@ -36,6 +36,7 @@ namespace Suspension::Fluid
     const MPI_Comm comm = space.communicator();
     for (auto *v : {&u, &u_old, &u_older, &unit_response, &rhs_u})
       v->reinit(space.owned_velocity, comm);
+    unit_response_alpha_over_dt = 0.;
     for (auto *v : {&p, &psi, &psi_old, &div_u, &div_u_load, &rhs_p})
       v->reinit(space.owned_pressure, comm);
     velocity_ghosted.reinit(space.owned_velocity, space.relevant_velocity, comm);
@@ -179,6 +180,9 @@ namespace Suspension::Fluid
   template <int dim>
   void ProjectionScheme<dim>::finish_mesh_change(Function<dim> *prescribed_velocity)
   {
+    // (the flow-rate response starts again from zero: carrying it over as
+    // a first guess saved 45 ms of its solve but cost 90 ms in the
+    // transfer, which reads PETSc vectors cell by cell; session 31)
     allocate_vectors();
     std::vector<VectorType *> velocities = {&u, &u_old};
     std::vector<VectorType *> pressures  = {&p, &psi, &psi_old};
@@ -235,19 +239,17 @@ namespace Suspension::Fluid
   }
 
   template <int dim>
-  void ProjectionScheme<dim>::update_unit_response(const double guess_scale)
+  void ProjectionScheme<dim>::update_unit_response()
   {
     VectorType b(operators.unit_force);
     b /= parameters.material.density;
-    // the operator is mass-dominated, so the response scales nearly as
-    // dt / alpha: the old one, scaled, is a close initial guess (after a
-    // mesh change the vector is new and zero)
-    if (guess_scale > 0.)
-      unit_response *= guess_scale;
+    if (unit_response_alpha_over_dt > 0.)
+      unit_response *= unit_response_alpha_over_dt / operators.momentum_alpha_over_dt;
     else
       unit_response = 0.;
     operators.solve_momentum(unit_response, b, parameters.fluid_solver.solver_tolerance);
     space.velocity_constraints.distribute(unit_response);
+    unit_response_alpha_over_dt = operators.momentum_alpha_over_dt;
   }
 
   namespace
@@ -309,14 +311,19 @@ namespace Suspension::Fluid
     const double old_alpha_over_dt = operators.momentum_alpha_over_dt;
     operators.set_momentum_coefficients(alpha / dt, nu);
     const bool driven = parameters.flow_driving.type != Parameters::FlowDrivingType::none;
+    const bool implicit_convection =
+      parameters.fluid_solver.convection == Parameters::ConvectionForm::semi_implicit;
+    // (with a step matrix the response is recomputed every step; with
+    // semi-implicit convection an imposed gradient joins the load instead)
+    const bool response_used =
+      driven && !operators.step_matrix &&
+      !(implicit_convection &&
+        parameters.flow_driving.type == Parameters::FlowDrivingType::constant_pressure_gradient);
     if (operators.momentum_alpha_over_dt != old_alpha_over_dt)
       {
         report.matrices_rebuilt = true;
-        // (with a step matrix the response is recomputed every step)
-        if (driven && !operators.step_matrix)
-          update_unit_response(old_alpha_over_dt > 0. ?
-                                 old_alpha_over_dt / operators.momentum_alpha_over_dt :
-                                 0.);
+        if (response_used)
+          update_unit_response();
       }
 
     // Extrapolated velocity (convection), history (time derivative) and
@@ -334,8 +341,6 @@ namespace Suspension::Fluid
     // With semi-implicit convection the force of the last step (or the
     // imposed gradient) joins the load; otherwise all of it comes from the
     // flow-rate control below.
-    const bool implicit_convection =
-      parameters.fluid_solver.convection == Parameters::ConvectionForm::semi_implicit;
     double imposed_force = 0.;
     if (implicit_convection)
       imposed_force =

@@ -72,18 +72,21 @@ namespace Suspension::Parameters
                       Patterns::Double(1e-3, 1.),
                       "Sub-step limit of the explicit SSP-RK transport: "
                       "dt |u| (2k+1) / h at most this (with SSP-RK2, 0.8 "
-                      "times this).");
+                      "times this; with SSP-RK(3,2), 1.41 times).");
     prm.declare_entry("Time integrator",
                       "SSP-RK3",
-                      Patterns::Selection("SSP-RK3|SSP-RK2"),
+                      Patterns::Selection("SSP-RK3|SSP-RK2|SSP-RK(3,2)"),
                       "Explicit integrator of the DG transport of phi and B: "
-                      "SSP-RK3 (Shu & Osher; 3 stages per sub-step) or "
-                      "SSP-RK2 (Heun; 2 stages, second order like DG 1 in "
-                      "space, only with Degree = 1: with DG 2 it is not "
-                      "L2-stable). Both are strong-stability preserving with "
-                      "coefficient 1; RK2's linear limit for DG 1, dt |u| 3 / "
-                      "h <= 1, is below RK3's 1.23, so its sub-steps are "
-                      "kept at 0.8 of 'Transport CFL'.");
+                      "SSP-RK3 (Shu & Osher; 3 stages per sub-step), "
+                      "SSP-RK2 (Heun; 2 stages) or SSP-RK(3,2) (Spiteri & "
+                      "Ruuth; 3 stages of half a sub-step each, second "
+                      "order, strong-stability preserving with coefficient "
+                      "2). The second-order ones only with Degree = 1 (with "
+                      "DG 2 they are not L2-stable). Their sub-steps sit at "
+                      "the same fraction of each one's linear limit for DG 1 "
+                      "(dt |u| 3 / h <= 1.23, 1 and 1.76, "
+                      "benchmarks/transport_integrator/stability.py): "
+                      "'Transport CFL' times 1, 0.8 and 1.41.");
     prm.declare_entry("Elastic number",
                       std::to_string(d.elastic_number),
                       Patterns::Double(1e-3, 100.),
@@ -263,7 +266,12 @@ namespace Suspension::Parameters
     degree              = prm.get_integer("Degree");
     limiter             = prm.get_bool("Limiter");
     transport_cfl       = prm.get_double("Transport CFL");
-    rk2                 = prm.get("Time integrator") == "SSP-RK2";
+    {
+      const std::string name = prm.get("Time integrator");
+      integrator = name == "SSP-RK2"     ? TransportIntegrator::ssp_rk2 :
+                   name == "SSP-RK(3,2)" ? TransportIntegrator::ssp_rk32 :
+                                           TransportIntegrator::ssp_rk3;
+    }
     elastic_number      = prm.get_double("Elastic number");
     semi_implicit       = prm.get("Elastic coupling") == "semi-implicit";
     sharp_stress        = prm.get("Stress weight") == "sharp";
@@ -285,9 +293,10 @@ namespace Suspension::Parameters
                        "THINC needs Degree >= 1 (the profiles reach the ghost cells "
                        "of other ranks through the phi DoFs of a cell); set it to "
                        "none with Degree = 0");
-    if (rk2 && degree > 1)
+    if (integrator != TransportIntegrator::ssp_rk3 && degree > 1)
       throw InputError("Solid/Time integrator",
-                       "SSP-RK2 is not L2-stable with DG " + std::to_string(degree) +
+                       prm.get("Time integrator") + " is not L2-stable with DG " +
+                         std::to_string(degree) +
                          " (Cockburn & Shu: degree k needs an order k + 1 Runge-Kutta "
                          "method); use SSP-RK3 or Degree = 1");
     interface_relaxation  = prm.get_double("Interface relaxation rate");

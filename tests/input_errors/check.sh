@@ -67,6 +67,7 @@ expect probe_one_coordinate "$dir/probe_one_coordinate.prm" -- "probe_one_coordi
 expect convection_assembled "$dir/convection_assembled.prm" -- "convection_assembled.prm" "Fluid solver/Convection" "matrix-free"
 expect convection_elastic_si "$dir/convection_elastic_semi_implicit.prm" -- "convection_elastic_semi_implicit.prm" "Fluid solver/Convection" "Elastic coupling"
 expect rk2_with_dg2       "$dir/rk2_with_dg2.prm"      -- "rk2_with_dg2.prm" "Solid/Time integrator" "DG 2"
+expect rk32_with_dg2      "$dir/rk32_with_dg2.prm"     -- "rk32_with_dg2.prm" "Solid/Time integrator" "SSP-RK(3,2)" "DG 2"
 expect levels_inverted    "$dir/levels_inverted.prm"   -- "levels_inverted.prm" "level"
 expect sweep_unknown_entry "$dir/sweep_unknown_entry.prm" -- "sweep_unknown_entry.prm" "Viscosityy"
 expect bad_boundary_velocity "$dir/bad_boundary_velocity.prm" -- "bad_boundary_velocity.prm" "Face y+/Velocity"

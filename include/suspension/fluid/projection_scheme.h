@@ -139,9 +139,11 @@ namespace Suspension::Fluid
     /// Ghosted copies of the transferred time levels, handed to new
     /// SolutionTransfer objects.
     void       attach_time_levels(bool serialization);
-    /// the response to a unit pressure gradient, from the old one times
-    /// guess_scale (0: from zero)
-    void       update_unit_response(double guess_scale);
+    /// The response to a unit pressure gradient for the present alpha/dt,
+    /// starting from the last one scaled by the ratio of the coefficients
+    /// (the operator is mass-dominated, so the response scales nearly as
+    /// dt / alpha), or from zero after a mesh change.
+    void       update_unit_response();
     double     flux(const VectorType &u) const;
 
     const Parameters::All &parameters;
@@ -165,6 +167,9 @@ namespace Suspension::Fluid
 
     // time levels (owned) and ghosted views for cell loops
     VectorType u, u_old, u_older, unit_response;
+    /// alpha/dt of the operator unit_response answers (0: none yet, e.g.
+    /// after a restart, which does not save it)
+    double     unit_response_alpha_over_dt = 0.;
     VectorType p, psi, psi_old, div_u, div_u_load;
     VectorType rhs_u, rhs_p;
     VectorType velocity_ghosted, pressure_ghosted;

@@ -32,9 +32,16 @@ namespace Suspension::Parameters
     unsigned int                     degree        = 1;
     bool                             limiter       = true;
     double                           transport_cfl = 0.5;
-    /// SSP-RK3 (3 stages per sub-step) or SSP-RK2 (2; DG 1 only, sub-steps
-    /// at 0.8 of the limit)
-    bool                             rk2 = false;
+    /// Explicit integrator of the DG transport: SSP-RK3 (3 stages per
+    /// sub-step), SSP-RK2 (2 stages) or SSP-RK(3,2) (3 stages, second
+    /// order, twice the forward-Euler bound); the last two with DG 1 only.
+    enum class TransportIntegrator
+    {
+      ssp_rk3,
+      ssp_rk2,
+      ssp_rk32
+    };
+    TransportIntegrator              integrator = TransportIntegrator::ssp_rk3;
     double                           elastic_number = 0.5;
     /// semi-implicit: the stress increment dt G phi (grad u B + B grad u^T),
     /// linear in the new velocity, goes into the momentum predictor
