@@ -196,35 +196,45 @@ namespace Suspension::Fluid
     // its diagonal is computed for the first component with a scalar
     // FEEvaluation and copied to the others: the unit vectors of one cell
     // are then 27 scalar ones instead of 81 three-component ones (in 3D,
-    // Q2), and one component instead of dim. (A Dirichlet value of one
-    // component only, e.g. a slip wall, decouples nothing from the free
-    // DoFs; the constrained DoFs' entries are not used.)
-    // deal.II's compute_diagonal() selects the component in a vector of
-    // vectors only.
-    std::vector<Vector> components(1);
-    matrix_free.initialize_dof_vector(components[0]);
-    // only the terms with a non-zero coefficient: the mass diagonal needs
-    // no gradients, the viscous one no values
+    // Q2), and one component instead of dim. A Dirichlet value of one
+    // component only (e.g. a slip wall) decouples nothing from the free
+    // DoFs, but where the first component is constrained and another is
+    // not, the first has no value to copy: then every component is
+    // computed. deal.II's compute_diagonal() selects the component in a
+    // vector of vectors only.
     const EvaluationFlags::EvaluationFlags flags =
       (mass != 0. ? EvaluationFlags::values : EvaluationFlags::nothing) |
       (viscosity != 0. ? EvaluationFlags::gradients : EvaluationFlags::nothing);
-    MatrixFreeTools::compute_diagonal<dim, fe_degree, n_q, 1, double, VectorizedArray<double>>(
-      matrix_free, components, [&](FEEvaluation<dim, fe_degree, n_q, 1, double> &u) {
-        u.evaluate(flags);
-        for (const unsigned int q : u.quadrature_point_indices())
-          {
-            if (mass != 0.)
-              u.submit_value(mass * u.get_value(q), q);
-            if (viscosity != 0.)
-              u.submit_gradient(viscosity * u.get_gradient(q), q);
-          }
-        u.integrate(flags);
-      },
-      0, 0, 0);
-    diagonal.swap(components[0]);
+    // only the terms with a non-zero coefficient: the mass diagonal needs
+    // no gradients, the viscous one no values
+    const auto component_diagonal = [&](std::vector<Vector> &components, const unsigned int c) {
+      MatrixFreeTools::compute_diagonal<dim, fe_degree, n_q, 1, double, VectorizedArray<double>>(
+        matrix_free, components, [&](FEEvaluation<dim, fe_degree, n_q, 1, double> &u) {
+          u.evaluate(flags);
+          for (const unsigned int q : u.quadrature_point_indices())
+            {
+              if (mass != 0.)
+                u.submit_value(mass * u.get_value(q), q);
+              if (viscosity != 0.)
+                u.submit_gradient(viscosity * u.get_gradient(q), q);
+            }
+          u.integrate(flags);
+        },
+        0, 0, c);
+    };
+    std::vector<Vector> components(dim);
+    for (auto &v : components)
+      matrix_free.initialize_dof_vector(v);
+    component_diagonal(components, 0);
+    matrix_free.initialize_dof_vector(diagonal);
+    diagonal = components[0];
 
     // copy: on each locally owned cell, DoF (c, i) takes the value of
     // (0, i); a support point's DoFs share one owner
+    std::vector<bool> is_constrained(diagonal.locally_owned_size(), false);
+    for (const unsigned int i : constrained)
+      is_constrained[i] = true;
+    bool                      first_alone_constrained = false;
     const DoFHandler<dim>    &dof_handler = matrix_free.get_dof_handler(0);
     const FiniteElement<dim> &fe          = dof_handler.get_fe();
     const auto               &partitioner = *diagonal.get_partitioner();
@@ -238,11 +248,21 @@ namespace Suspension::Fluid
               const auto [component, index] = fe.system_to_component_index(i);
               if (component == 0 || !partitioner.in_local_range(dofs[i]))
                 continue;
-              const types::global_dof_index first = dofs[fe.component_to_system_index(0, index)];
-              diagonal.local_element(partitioner.global_to_local(dofs[i])) =
-                diagonal.local_element(partitioner.global_to_local(first));
+              const unsigned int target = partitioner.global_to_local(dofs[i]);
+              const unsigned int source =
+                partitioner.global_to_local(dofs[fe.component_to_system_index(0, index)]);
+              diagonal.local_element(target) = components[0].local_element(source);
+              first_alone_constrained |= is_constrained[source] && !is_constrained[target];
             }
         }
+    if (Utilities::MPI::logical_or(first_alone_constrained, diagonal.get_mpi_communicator()))
+      {
+        for (unsigned int c = 1; c < dim; ++c)
+          component_diagonal(components, c);
+        diagonal = 0.;
+        for (const auto &v : components)
+          diagonal += v;
+      }
   }
 
   template <int dim>
