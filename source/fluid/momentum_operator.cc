@@ -222,9 +222,9 @@ namespace Suspension::Fluid
         },
         0, 0, c);
     };
+    // the other components' vectors only if they are computed (below)
     std::vector<Vector> components(dim);
-    for (auto &v : components)
-      matrix_free.initialize_dof_vector(v);
+    matrix_free.initialize_dof_vector(components[0]);
     component_diagonal(components, 0);
     matrix_free.initialize_dof_vector(diagonal);
     diagonal = components[0];
@@ -258,7 +258,10 @@ namespace Suspension::Fluid
     if (Utilities::MPI::logical_or(first_alone_constrained, diagonal.get_mpi_communicator()))
       {
         for (unsigned int c = 1; c < dim; ++c)
-          component_diagonal(components, c);
+          {
+            matrix_free.initialize_dof_vector(components[c]);
+            component_diagonal(components, c);
+          }
         diagonal = 0.;
         for (const auto &v : components)
           diagonal += v;
