@@ -158,30 +158,48 @@ namespace Suspension::Solid
                 volume += b.JxW(q)[v];
               }
             mean /= volume;
-            const double lambda_mean = smallest_eigenvalue(tensor(mean, v));
-            if (!(lambda_mean > 0.))
+            const SymmetricTensor<2, dim> B_mean = tensor(mean, v);
+            // the smallest eigenvalue is at most the smallest diagonal entry
+            double upper = B_mean[0][0];
+            for (unsigned int d = 1; d < dim; ++d)
+              upper = std::min(upper, B_mean[d][d]);
+            if (!(upper > 0.))
               continue; // nothing a scaling can do; the SPD check reports it
+            const unsigned int n_nodes     = b.dofs_per_component;
+            const auto         for_points = [&](const auto &action) {
+              for (const unsigned int q : b.quadrature_point_indices())
+                action(b.get_value(q));
+              for (unsigned int i = 0; i < n_nodes; ++i)
+                {
+                  Tensor<1, n_B, VA> node;
+                  for (unsigned int c = 0; c < n_B; ++c)
+                    node[c] = b.begin_dof_values()[c * n_nodes + i];
+                  action(node);
+                }
+            };
+            // Where every point's eigenvalues exceed a tenth of that bound
+            // (nearly everywhere), they exceed the floor below, and the
+            // mean's eigenvalue (an eigensolver in 3D) is not needed.
+            bool all_clear = true;
+            for_points([&](const Tensor<1, n_B, VA> &value) {
+              all_clear = all_clear && eigenvalues_exceed(tensor(value, v), 0.1 * upper);
+            });
+            if (all_clear)
+              continue;
+            const double lambda_mean = smallest_eigenvalue(B_mean);
+            if (!(lambda_mean > 0.))
+              continue;
             // keep at least a tenth of the mean's smallest eigenvalue
             const double floor = 0.1 * lambda_mean;
             double       theta = 1.;
-            const auto   consider = [&](const Tensor<1, n_B, VA> &value) {
+            for_points([&](const Tensor<1, n_B, VA> &value) {
               const SymmetricTensor<2, dim> B = tensor(value, v);
               if (eigenvalues_exceed(B, floor)) // nearly always: no eigensolver
                 return;
               const double lambda = smallest_eigenvalue(B);
               if (lambda < floor)
                 theta = std::min(theta, (lambda_mean - floor) / (lambda_mean - lambda));
-            };
-            for (const unsigned int q : b.quadrature_point_indices())
-              consider(b.get_value(q));
-            const unsigned int n_nodes = b.dofs_per_component;
-            for (unsigned int i = 0; i < n_nodes; ++i)
-              {
-                Tensor<1, n_B, VA> node;
-                for (unsigned int c = 0; c < n_B; ++c)
-                  node[c] = b.begin_dof_values()[c * n_nodes + i];
-                consider(node);
-              }
+            });
             if (theta < 1.)
               {
                 ++n_limited;
