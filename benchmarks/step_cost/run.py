@@ -57,6 +57,13 @@ SCENES = {
         1, "suspension_channel_3d_reduced.prm",
         ["Mesh refinement/Maximum level=4", "Time stepping/Maximum number of steps=2",
          "Statistics/Enabled=false"]),
+    # per step and per unit of simulated time: a scene may take shorter steps
+    # with fewer transport sub-steps each (session 33); one rank, so that it
+    # runs beside a study on the other core
+    "3D reduced box, 6 steps (level 4, 1 rank, per time unit)": (
+        1, "suspension_channel_3d_reduced.prm",
+        ["Mesh refinement/Maximum level=4", "Time stepping/Maximum number of steps=6",
+         "Statistics/Enabled=false", "Output/Progress interval=1"]),
     "cavity disc to t = 1 (32 cells per diameter, 1 rank)": (
         1, "disc_cavity_2d.prm",
         ["Time stepping/End time=1", "Output/Write phi cells=false"]),
@@ -136,6 +143,12 @@ def run(exe, tree, name, ranks, prm, sets, label):
     row["s_per_step"] = (round((row["solver_s"] - float(re.search(
         r"\|\s*setup \(mesh, DoFs, matrices\)\s*\|\s*\d+\s*\|\s*([0-9.e+]+)s", text).group(1)))
         / int(m.group(1)), 3) if m and row["solver_s"] != "" else "")
+    # simulated time reached (the last progress line, where the scene prints one)
+    m = re.findall(r"step\s+\d+\s+t = ([0-9.e+-]+)", text)
+    row["t_end"] = float(m[-1]) if m else ""
+    row["s_per_time_unit"] = (round(row["s_per_step"] * int(re.search(
+        r"Maximum number of steps=(\d+)", " ".join(sets)).group(1)) / row["t_end"], 1)
+        if m and row["s_per_step"] != "" else "")
     m = re.search(r"Memory: peak resident .*?, ([0-9.]+) kB per velocity DoF", text)
     row["kB_per_velocity_dof"] = float(m.group(1)) if m else ""
     m = re.search(r"elastic energy where phi < 1/2: ([0-9.e+-]+) %", text)
@@ -151,7 +164,7 @@ def run(exe, tree, name, ranks, prm, sets, label):
 def table(rows):
     by = {(r["scene"], r["code"]): r for r in rows}
     print(f"{'scene':52s} {'':5s} {'wall s':>8s} {'solver s':>9s} {'transport':>9s} "
-          f"{'peak MB':>8s} {'s/step':>7s} {'kB/vDoF':>7s}")
+          f"{'peak MB':>8s} {'s/step':>7s} {'kB/vDoF':>7s} {'s/t':>8s}")
     num = lambda r, k: float(r[k]) if r.get(k) not in (None, "") else float("nan")
     for scene in dict.fromkeys(r["scene"] for r in rows):
         for code in ("old", "new"):
@@ -160,13 +173,15 @@ def table(rows):
                 print(f"{scene:52s} {code:5s} {float(r['wall_s']):8.1f} {float(r['solver_s'] or 0):9.1f} "
                       f"{float(r['solid transport']):9.1f} {float(r['peak_MB']):8.0f}"
                       f" {num(r, 's_per_step'):7.2f} {num(r, 'kB_per_velocity_dof'):7.2f}"
+                      f" {num(r, 's_per_time_unit'):8.1f}"
                       + (f"  mu_eff {r['mu_eff']}, N1 {r['N1']}, N2 {r['N2']}" if r.get("mu_eff") else ""))
         if (scene, "old") in by and (scene, "new") in by:
             o, n = by[(scene, "old")], by[(scene, "new")]
             ratio = lambda k: num(n, k) / num(o, k) if num(o, k) > 0 else float("nan")
             print(f"{'':52s} {'ratio':5s} {ratio('wall_s'):8.2f} {ratio('solver_s'):9.2f} "
                   f"{ratio('solid transport'):9.2f} {ratio('peak_MB'):8.2f} "
-                  f"{ratio('s_per_step'):7.2f} {ratio('kB_per_velocity_dof'):7.2f}")
+                  f"{ratio('s_per_step'):7.2f} {ratio('kB_per_velocity_dof'):7.2f} "
+                  f"{ratio('s_per_time_unit'):8.2f}")
 
 
 def chart(rows, png="step_cost.png"):

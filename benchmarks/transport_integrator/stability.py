@@ -34,6 +34,10 @@ METHODS = {
     "SSP-RK3": lambda z: 1 + z + z**2 / 2 + z**3 / 6,
     # y1 = y0 + h/2 L y0, y2 = y1 + h/2 L y1, y3 = y0/3 + 2/3 (y2 + h/2 L y2)
     "SSP-RK(3,2)": lambda z: 1. / 3. + 2. / 3. * (1 + z / 2)**3,
+    # a candidate, not in the solver (session 33): Spiteri & Ruuth's
+    # four-stage third-order method, y1 = y0 + h/2 L y0, y2 = y1 + h/2 L y1,
+    # y3 = 2/3 y0 + 1/3 (y2 + h/2 L y2), y4 = y3 + h/2 L y3
+    "SSP-RK(4,3)": lambda z: (2. / 3. + 1. / 3. * (1 + z / 2)**3) * (1 + z / 2),
 }
 
 thetas = np.linspace(0., 2. * np.pi, 721)
@@ -48,5 +52,5 @@ for k in (1, 2):
                 lo = mid
             else:
                 hi = mid
-        stages = 2 if name == "SSP-RK2" else 3
+        stages = {"SSP-RK2": 2, "SSP-RK(4,3)": 4}.get(name, 3)
         print(f"{k:2d} {name:12s} {lo:8.4f} {lo * (2 * k + 1):14.4f} {lo / stages:10.4f}")
