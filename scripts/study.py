@@ -25,8 +25,8 @@ While it runs, one line every 30 s: cases done, running (with their
 times), and the ETA of the whole study from the simulated time per
 second so far. At the end (and after every finished case) the study's
 table Study/Directory/study.csv and its figures (scripts/plot_study.py).
---max-cases K stops after K cases have finished in this invocation (a
-test of resumption). --collect only writes the table and the figures from
+--max-cases K stops after K cases have finished or failed in this
+invocation (a test of resumption; a failed case is not replaced by the next). --collect only writes the table and the figures from
 the cases finished so far (for example while a part of the study runs
 under --set 'Study/Volume fractions=...').
 --save-state archives the unfinished cases (checkpoint, statistics, logs;
@@ -283,7 +283,7 @@ last_report = 0.
 try:
     while pending or running:
         while (pending and len(running) < jobs and
-               (a.max_cases == 0 or finished_now + len(running) < a.max_cases)):
+               (a.max_cases == 0 or finished_now + len(failed) + len(running) < a.max_cases)):
             case = pending.pop(0)
             restore_state(case)
             if os.path.isfile(os.path.join(directory(case), "case_done.json")):

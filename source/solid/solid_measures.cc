@@ -37,6 +37,7 @@ namespace Suspension::Solid
     const unsigned int nc  = fe.n_components();
     const double       G   = parameters.solid.shear_modulus;
     Point<dim>         worst;
+    double             worst_phi = 0.;
     std::vector<Vector<double>> values(quadrature.size(), Vector<double>(nc));
     std::vector<Tensor<1, dim>> grad_phi(quadrature.size());
     double volume = 0., lo = 1e300, hi = -1e300, det_min = 1e300, eig_min = 1e300, eig_max = 1.;
@@ -115,14 +116,19 @@ namespace Suspension::Solid
                 }
               if (weight.sharp)
                 stiffness = std::max(stiffness, H * largest);
-              if (phi[q] < solid_threshold)
+              // checked where B carries stress: with the sharp weight B is
+              // reset to I where H = 0, and between those nodes and the
+              // solid's its interpolant at a point with H = 0 means nothing
+              // (it stopped a 3D run at phi = 0.14, session 33)
+              if (weight.sharp ? !(H > 0.) : phi[q] < solid_threshold)
                 continue;
               det_min = std::min(det_min, determinant(B));
               eig_max = std::max(eig_max, largest);
               if (smallest < eig_min || !std::isfinite(smallest))
                 {
                   eig_min = smallest;
-                  worst   = fe_values.quadrature_point(q);
+                  worst     = fe_values.quadrature_point(q);
+                  worst_phi = phi[q];
                 }
             }
         }
@@ -157,6 +163,7 @@ namespace Suspension::Solid
         const Point<dim> where = Utilities::MPI::broadcast(comm, worst, m.min_index);
         for (unsigned int c = 0; c < dim; ++c)
           d.worst_B_location[c] = where[c];
+        d.worst_B_phi = Utilities::MPI::broadcast(comm, worst_phi, m.min_index);
       }
     return d;
   }

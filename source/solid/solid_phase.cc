@@ -594,7 +594,8 @@ namespace Suspension::Solid
                 << t << " at (" << d.worst_B_location[0];
         for (unsigned int c = 1; c < dim; ++c)
           message << ", " << d.worst_B_location[c];
-        message << ") (smallest eigenvalue " << d.min_eigenvalue_B
+        message << "), where phi = " << d.worst_B_phi << " (stress weight H = "
+                << weight(d.worst_B_phi) << ") (smallest eigenvalue " << d.min_eigenvalue_B
                 << "); reduce the time step ('Solid/Elastic number', 'Time stepping/CFL "
                    "number') or refine the mesh; the last state was written";
         throw std::runtime_error(message.str());

@@ -41,10 +41,11 @@ namespace Suspension::Solid
     double       min_phi = 0., max_phi = 0.;
     unsigned int limited_cells = 0, out_of_bound_means = 0, substeps = 0;
     double       min_det_B = 1., min_eigenvalue_B = 1.;
-    double       max_eigenvalue_B = 1.; // where phi >= 0.1
+    double       max_eigenvalue_B = 1.; // where B is checked (solid_threshold)
     /// largest H(phi) lambda_max(B): the elastic wave speed is sqrt(G H lambda / rho)
     double       wave_stiffness   = 1.;
     std::array<double, 3> worst_B_location{}; // where min_eigenvalue_B is
+    double                worst_B_phi = 1.;    // phi there
     /// share of the elastic energy (G/2) H (tr B - dim - ln det B) where phi < 1/2
     double       tail_energy_share = 0.;
     /// cells across 0.01 < phi < 0.99: its measure over the length (area)
@@ -241,7 +242,8 @@ namespace Suspension::Solid
     values_at(const typename DoFHandler<dim>::active_cell_iterator &solid_cell,
               const std::vector<Point<dim>>                         &unit_points) const;
 
-    /// B is checked (SPD) where phi is at least this.
+    /// With the stress weight H = phi, B is checked (SPD) where phi is at
+    /// least this; with the sharp weight, where H(phi) > 0.
     static constexpr double solid_threshold = 0.1;
     /// Stress weight 'phi': B is reset to I in cells where phi is below
     /// this at every node.
