@@ -26,8 +26,9 @@ times), and the ETA of the whole study from the simulated time per
 second so far. At the end (and after every finished case) the study's
 table Study/Directory/study.csv and its figures (scripts/plot_study.py).
 --max-cases K stops after K cases have finished or failed in this
-invocation (a test of resumption; a failed case is not replaced by the next). --collect only writes the table and the figures from
-the cases finished so far (for example while a part of the study runs
+invocation (a test of resumption; a failed case is not replaced by the
+next). --collect only writes the table and the figures from the cases
+finished so far (for example while a part of the study runs
 under --set 'Study/Volume fractions=...').
 --save-state archives the unfinished cases (checkpoint, statistics, logs;
 no field files) to study_state/<study directory>/<case>.tar.xz; a later

@@ -248,12 +248,12 @@ namespace Suspension::Fluid
     // entries per row (hypre's advice for 3D): coarse operators with fewer
     // entries, a V-cycle 2.5 times cheaper on the reduced 3D box for 6 %
     // more iterations. In 2D it saved nothing (doc/performance.md, session 33).
-    const ScopedPetscOptions hypre_options(
-      dim == 3 ? std::vector<std::pair<std::string, std::string>>{
-                   {"-pc_hypre_boomeramg_coarsen_type", "HMIS"},
-                   {"-pc_hypre_boomeramg_interp_type", "ext+i"},
-                   {"-pc_hypre_boomeramg_P_max", "4"}} :
-                 std::vector<std::pair<std::string, std::string>>{});
+    std::vector<std::pair<std::string, std::string>> options;
+    if (dim == 3)
+      options = {{"-pc_hypre_boomeramg_coarsen_type", "HMIS"},
+                 {"-pc_hypre_boomeramg_interp_type", "ext+i"},
+                 {"-pc_hypre_boomeramg_P_max", "4"}};
+    const ScopedPetscOptions hypre_options(std::move(options));
     amg_pressure->initialize(L, data);
     jacobi_mass = std::make_unique<PETScWrappers::PreconditionJacobi>(Mp);
 

@@ -41,7 +41,7 @@ namespace Suspension::Solid
     double       min_phi = 0., max_phi = 0.;
     unsigned int limited_cells = 0, out_of_bound_means = 0, substeps = 0;
     double       min_det_B = 1., min_eigenvalue_B = 1.;
-    double       max_eigenvalue_B = 1.; // where B is checked (solid_threshold)
+    double       max_eigenvalue_B = 1.; // all three where B is checked (see solid_threshold)
     /// largest H(phi) lambda_max(B): the elastic wave speed is sqrt(G H lambda / rho)
     double       wave_stiffness   = 1.;
     std::array<double, 3> worst_B_location{}; // where min_eigenvalue_B is
