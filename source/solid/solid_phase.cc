@@ -469,6 +469,17 @@ namespace Suspension::Solid
     time += dt;
     sharpen_interface();
     reset_B_in_fluid(dt);
+    // The reset puts I at nodes next to stretched ones. Above degree 1 the
+    // Lagrange basis is negative between its nodes, so the mix can leave
+    // the SPD cone at a point inside the cell (the 3D box stopped so at
+    // phi = 0.98, session 34): limit B once more. The cell means stay
+    // SPD, positive combinations of the nodes' values (the basis
+    // functions' integrals are positive), so the scaling always exists.
+    if (scale && parameters.solid.degree > 1 && fe.n_components() > 1)
+      {
+        solution.zero_out_ghost_values();
+        report.limited_cells += transport.limit_B(solution);
+      }
 
     SolidDiagnostics d     = diagnostics();
     d.limited_cells        = Utilities::MPI::sum(report.limited_cells, dof_handler.get_communicator());
